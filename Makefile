@@ -1,0 +1,95 @@
+# sicm: build, test, install, demo.
+#
+#   make            build build/sicm and build/libsicmrt.a
+#   make check      install missing Debian packages, build, run every test
+#   make demo       install missing Debian packages, build, run an example scene
+#   make install    install sicm under $(PREFIX)
+#   make clean
+#
+# Variables: WERROR=1 adds -Werror (CI), UPDATE=1 makes `make check` rewrite
+# expectations for review, SANITIZE=1 builds with ASan and UBSan.
+
+PREFIX   ?= /usr/local
+BUILD    ?= build
+CXX      ?= g++
+CC       ?= gcc
+
+WARN      := -Wall -Wextra $(if $(WERROR),-Werror)
+OPT       ?= -O2
+comma     := ,
+SANFLAGS  := $(if $(SANITIZE),-fsanitize=address$(comma)undefined -fno-omit-frame-pointer)
+CPPFLAGS  := -Icompiler -Iruntime/include -MMD -MP
+CXXFLAGS  := -std=c++20 $(OPT) -g $(WARN) $(SANFLAGS)
+CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(SANFLAGS)
+LDFLAGS   := $(SANFLAGS)
+LIBS      := -lgc -lgmp -lreadline -lm -lpthread
+
+# ---- sources, per component --------------------------------------------
+COMPILER_SRCS := $(wildcard compiler/*.cpp compiler/*/*.cpp)
+RUNTIME_SRCS  := $(wildcard runtime/src/*.c)
+UNIT_SRCS     := $(wildcard tests/unit/*.cpp)
+
+# The standard library, embedded in the binary; listed in load order.
+STDLIB_FILES  := stdlib/prelude.sicm
+STDLIB_GEN    := $(BUILD)/gen/stdlib_embed.cpp
+
+COMPILER_OBJS := $(COMPILER_SRCS:%.cpp=$(BUILD)/%.o) $(BUILD)/gen/stdlib_embed.o
+RUNTIME_OBJS  := $(RUNTIME_SRCS:%.c=$(BUILD)/%.o)
+UNIT_OBJS     := $(UNIT_SRCS:%.cpp=$(BUILD)/%.o)
+# Everything of the compiler except its entry point, for the unit tests.
+LIB_OBJS      := $(filter-out $(BUILD)/compiler/main.o,$(COMPILER_OBJS))
+
+SICM    := $(BUILD)/sicm
+RTLIB   := $(BUILD)/libsicmrt.a
+UNITBIN := $(BUILD)/unit-tests
+
+.PHONY: all check demo install clean deps unit
+all: $(SICM) $(RTLIB)
+
+$(BUILD)/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -c $< -o $@
+
+$(STDLIB_GEN): $(STDLIB_FILES) scripts/embed-stdlib
+	@python3 scripts/embed-stdlib $@ $(STDLIB_FILES)
+
+$(BUILD)/gen/stdlib_embed.o: $(STDLIB_GEN)
+	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -c $< -o $@
+
+$(BUILD)/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+$(RTLIB): $(RUNTIME_OBJS)
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
+
+$(SICM): $(COMPILER_OBJS) $(RTLIB)
+	$(CXX) $(LDFLAGS) $(COMPILER_OBJS) $(RTLIB) $(LIBS) -o $@
+
+$(UNITBIN): $(UNIT_OBJS) $(LIB_OBJS) $(RTLIB)
+	$(CXX) $(LDFLAGS) $(UNIT_OBJS) $(LIB_OBJS) $(RTLIB) $(LIBS) -lgtest -lgtest_main -o $@
+
+unit: $(UNITBIN)
+
+deps:
+	@scripts/install-deps
+
+check: deps
+	@$(MAKE) --no-print-directory all $(UNITBIN)
+	@python3 tests/run --sicm $(SICM) --unit $(UNITBIN) $(if $(UPDATE),--update)
+
+demo: deps
+	@$(MAKE) --no-print-directory all
+	$(SICM) run examples/demo.sicm
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/sicm
+	install -m 755 $(SICM) $(DESTDIR)$(PREFIX)/bin/sicm
+	install -m 644 $(RTLIB) $(DESTDIR)$(PREFIX)/lib/libsicmrt.a
+	install -m 644 runtime/include/sicm/*.h $(DESTDIR)$(PREFIX)/include/sicm/
+
+clean:
+	rm -rf $(BUILD)
+
+-include $(COMPILER_OBJS:.o=.d) $(RUNTIME_OBJS:.o=.d) $(UNIT_OBJS:.o=.d)

@@ -1,0 +1,25 @@
+// Declarations shared by the core primitives and the evaluator.
+#pragma once
+
+#include <string_view>
+
+#include "eval/value.hpp"
+
+namespace sicm {
+
+void install_core_primitives();
+void install_list_primitives();
+
+bool eqv(Value a, Value b);
+bool equal(Value a, Value b);
+
+// All program output goes through here (so with-output-to-string can capture it).
+void output(std::string_view s);
+void flush_output();
+int output_column();
+
+// Escape-only continuations made by call/cc.
+bool is_continuation(Value v);
+[[noreturn]] void throw_to_continuation(Value k, Value *args, int nargs);
+
+} // namespace sicm

@@ -1,0 +1,133 @@
+// The interpreter's top level: start-up, whole-program checks, running a
+// source file form by form.
+#include "eval/interp.hpp"
+
+#include <algorithm>
+#include <unordered_set>
+
+#include "eval/analyze.hpp"
+#include "eval/builtins.hpp"
+#include "eval/core.hpp"
+#include "eval/number.hpp"
+#include "eval/procedure.hpp"
+#include "eval/stdlib.hpp"
+#include "print/printer.hpp"
+#include "syntax/reader.hpp"
+
+namespace sicm {
+
+namespace {
+
+struct GlobalUse {
+  Symbol *name;
+  SrcLoc loc;
+};
+std::vector<GlobalUse> *g_uses = nullptr; // collecting during check_program
+
+void record_use(Symbol *name, SrcLoc loc) {
+  if (g_uses) g_uses->push_back(GlobalUse{name, loc});
+}
+
+size_t edit_distance(const std::string &a, const std::string &b) {
+  std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j)
+    prev[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+// The closest known name to `name`, or "" if nothing is close enough.
+std::string suggestion(const std::string &name, const std::vector<std::string> &known) {
+  std::string best;
+  size_t best_d = std::max<size_t>(1, name.size() / 3) + 1;
+  for (const std::string &k : known) {
+    size_t d = edit_distance(name, k);
+    if (d < best_d) {
+      best_d = d;
+      best = k;
+    }
+  }
+  return best;
+}
+
+void load_embedded_stdlib() {
+  for (const EmbeddedSource *s = embedded_stdlib(); s->name; ++s) {
+    uint32_t file = register_source(std::string("<stdlib>/") + s->name, s->text);
+    for (const ReadForm &f : read_all(file))
+      eval_toplevel(f.datum, f.loc);
+  }
+}
+
+} // namespace
+
+void init_interpreter() {
+  install_special_forms();
+  install_core_primitives();
+  install_list_primitives();
+  install_number_primitives();
+  install_text_primitives();
+  install_vector_primitives();
+  load_embedded_stdlib();
+}
+
+Value eval_toplevel(Value datum, SrcLoc loc) {
+  Node *n = analyze_form(datum, loc, nullptr);
+  return eval(n, nullptr);
+}
+
+bool is_printable_toplevel(Value datum, Value result) {
+  if (is_definition(datum)) return false;
+  return !result.is(Tag::Unspecified) && !result.is(Tag::Default);
+}
+
+std::vector<std::string> global_names() {
+  // Every bound, interned symbol: intern() of a name gives the same symbol,
+  // so walk the names the table knows through a probe list built at need.
+  return bound_global_names();
+}
+
+void check_program(const gcvec<ReadForm> &forms) {
+  std::vector<Symbol *> defined;
+  for (const ReadForm &f : forms)
+    toplevel_defined_names(f.datum, defined);
+  std::unordered_set<Symbol *> defined_set(defined.begin(), defined.end());
+  std::vector<GlobalUse> uses;
+  g_uses = &uses;
+  try {
+    for (const ReadForm &f : forms)
+      analyze_form(f.datum, f.loc, record_use);
+  } catch (...) {
+    g_uses = nullptr;
+    throw;
+  }
+  g_uses = nullptr;
+  for (const GlobalUse &u : uses) {
+    if (u.name->bound || defined_set.count(u.name)) continue;
+    std::vector<std::string> known = global_names();
+    for (Symbol *d : defined)
+      known.push_back(d->name);
+    std::string near = suggestion(u.name->name, known);
+    throw Error(ErrorKind::Syntax, u.loc, "Unbound variable: " + u.name->name,
+                near.empty() ? "" : "did you mean '" + near + "'?");
+  }
+}
+
+void run_source(uint32_t file) {
+  gcvec<ReadForm> forms = read_all(file);
+  check_program(forms);
+  for (const ReadForm &f : forms) {
+    Value v = eval_toplevel(f.datum, f.loc);
+    if (is_printable_toplevel(f.datum, v)) {
+      output(write_string(v));
+      output("\n");
+    }
+  }
+  flush_output();
+}
+
+} // namespace sicm

@@ -1,0 +1,35 @@
+// The interpreter's public face: what `sicm run`, the REPL and the tests use.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "eval/value.hpp"
+#include "syntax/error.hpp"
+
+namespace sicm {
+
+// Set up the global environment: every primitive, then the Scheme prelude.
+// Call once, after GC_INIT(), on the thread that will evaluate.
+void init_interpreter();
+
+// Analyze and evaluate one top-level form read from a source. Throws Error.
+Value eval_toplevel(Value datum, SrcLoc loc);
+
+// True if a top-level form's value should be printed: the form is not a
+// definition and the value is not unspecified.
+bool is_printable_toplevel(Value datum, Value result);
+
+// Evaluate every form of a registered source in order, printing the
+// printable values (as `sicm run` does) to stdout. Throws Error.
+void run_source(uint32_t file);
+
+// Check a whole program before running it: every free identifier must be
+// defined by the program or by the global environment. Throws a Syntax
+// Error listing the first unknown name (with a "did you mean" note).
+void check_program(const gcvec<struct ReadForm> &forms);
+
+// The names bound in the global environment (for REPL completion).
+std::vector<std::string> global_names();
+
+} // namespace sicm

@@ -1,0 +1,40 @@
+// Procedures written in C++: how they are declared, registered and how they
+// report misuse in MIT Scheme's words.
+#pragma once
+
+#include <string>
+
+#include "eval/value.hpp"
+
+namespace sicm {
+
+// A primitive receives its evaluated arguments in a contiguous array.
+using PrimFn = Value (*)(Value *args, int nargs);
+
+struct Primitive {
+  const char *name;
+  int min_args;
+  int max_args; // -1: any number
+  PrimFn fn;
+};
+
+constexpr int kVariadic = -1;
+
+// Bind `name` in the global environment to a new primitive.
+void define_primitive(const char *name, int min_args, int max_args, PrimFn fn);
+// Bind `name` to an existing value (constants such as pi, aliases).
+void define_global(const char *name, Value v);
+
+// MIT-style argument errors, raised at current_call_loc(). argpos is 1-based.
+//   "The object (), passed as the first argument to car, is not the correct type."
+[[noreturn]] void wrong_type(Value obj, int argpos, const char *who);
+//   "The object 10, passed as the second argument to vector-ref, is not in the correct range."
+[[noreturn]] void bad_range(Value obj, int argpos, const char *who);
+
+// Argument checkers that return the unwrapped value or raise wrong_type.
+int64_t arg_fixnum(Value *args, int i, const char *who); // exact integer in int64 range
+size_t arg_index(Value *args, int i, const char *who);   // exact non-negative integer
+std::string_view arg_string(Value *args, int i, const char *who);
+Symbol *arg_symbol(Value *args, int i, const char *who);
+
+} // namespace sicm

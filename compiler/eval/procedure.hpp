@@ -1,0 +1,87 @@
+// The analyzed program: AST nodes with lexical addresses, lambdas, closures
+// and environment frames.
+//
+// The analyzer (analyze.cpp) turns a datum into a tree of Nodes once; the
+// evaluator (eval.cpp) walks Nodes. Local variables are addressed by
+// (depth, index) into a chain of Frames; globals live in their Symbol.
+#pragma once
+
+#include "eval/value.hpp"
+
+namespace sicm {
+
+enum class NodeKind : uint8_t {
+  Const,        // a literal or quoted datum
+  LocalRef,     // frame (depth, index)
+  GlobalRef,    // symbol's global binding
+  SetLocal,     // set! / internal define of a local
+  SetGlobal,    // set! of a global (must be bound)
+  DefineGlobal, // top-level define
+  If,
+  Lambda, // creates a closure
+  Seq,    // begin / bodies
+  Call,
+  And,
+  Or,
+  Let,      // new frame; inits evaluated in the outer environment
+  Letrec,   // new frame; inits evaluated inside it, in order
+  Delay,    // make a promise of kids[0] (make_stream: cons-stream's tail)
+  FluidLet, // temporarily set variables, evaluate body, restore
+};
+
+struct Lambda;
+
+struct Node {
+  NodeKind kind;
+  bool tail = false;  // in tail position of its lambda
+  uint16_t depth = 0; // LocalRef / SetLocal: frames to walk up
+  uint32_t index = 0; // LocalRef / SetLocal: slot; Let/Letrec: frame size
+  SrcLoc loc;
+  Value value;           // Const: the datum; GlobalRef/SetGlobal/DefineGlobal: the symbol
+  Node **kids = nullptr; // sub-nodes (meaning depends on kind)
+  uint32_t nkids = 0;
+  Lambda *lambda = nullptr; // Lambda nodes
+};
+
+struct Lambda {
+  Symbol *name = nullptr; // for printing and error messages; null if anonymous
+  uint32_t nrequired = 0;
+  uint32_t noptional = 0;  // #!optional parameters, bound to #!default when missing
+  bool rest = false;       // a rest parameter collects the remaining arguments
+  uint32_t frame_size = 0; // parameters + internal definitions
+  Node *body = nullptr;
+  SrcLoc loc;
+};
+
+struct Frame {
+  Frame *parent;
+  uint32_t size;
+  Value slots[1]; // really `size` slots
+};
+
+struct Closure {
+  Lambda *lambda;
+  Frame *env;
+};
+
+Frame *make_frame(Frame *parent, uint32_t size);
+
+// Apply any procedure to arguments (used by primitives such as map, apply, sort).
+Value apply_procedure(Value proc, Value *args, int nargs);
+// Force a promise (other values are returned as they are).
+Value force_promise(Value v);
+inline bool is_procedure(Value v) {
+  return v.is(Tag::Closure) || v.is(Tag::Primitive);
+}
+
+// Analyze a datum (with the position of the whole form) in the global scope.
+Node *analyze_toplevel(Value datum, SrcLoc loc);
+// Evaluate an analyzed node in an environment (null for top level).
+Value eval(Node *node, Frame *env);
+
+// The stack guard: evaluation deeper than the limit raises MIT's
+// "Aborting!: maximum recursion depth exceeded" instead of crashing.
+void set_stack_limit(char *stack_base, size_t usable_bytes);
+void check_stack(SrcLoc where = {});
+
+} // namespace sicm
