@@ -22,8 +22,8 @@ constexpr int kExitNoInput = 66; // EX_NOINPUT
 // The evaluator runs on a thread with a large stack so that deep (non-tail)
 // recursion in user programs works as it does in MIT Scheme; the stack guard
 // turns recursion beyond it into a clean error.
-constexpr size_t kEvalStackBytes = size_t(1) << 30;    // 1 GiB reserved, touched as used
-constexpr size_t kStackGuardMargin = size_t(64) << 20; // kept free for primitives
+constexpr size_t kEvalStackBytes = size_t(256) << 20;  // reserved; pages are touched as used
+constexpr size_t kStackGuardMargin = size_t(16) << 20; // kept free for primitives
 
 const char kUsage[] =
     "usage: sicm run FILE        evaluate a program, printing each top-level value\n"

@@ -164,6 +164,37 @@ Value apply_procedure(Value proc, Value *args, int nargs) {
   return eval(c->lambda->body, f);
 }
 
+// The slower call paths live in their own functions, so that eval's own
+// stack frame stays small: its size is what deep recursion pays per level.
+[[gnu::noinline]] Frame *bind_evaluated(Value f, Closure *c, Node *n, Frame *env) {
+  long nargs = n->nkids - 1;
+  Value small[kSmallArgs];
+  gcvec<Value> big;
+  Value *args = small;
+  if (nargs > kSmallArgs) {
+    big.resize(nargs);
+    args = big.data();
+  }
+  for (long i = 0; i < nargs; ++i)
+    args[i] = eval(n->kids[i + 1], env);
+  return bind_arguments(f, c, args, nargs, n->loc);
+}
+
+[[gnu::noinline]] Value call_evaluated(Value f, Node *n, Frame *env) {
+  long nargs = n->nkids - 1;
+  Value small[kSmallArgs];
+  gcvec<Value> big;
+  Value *args = small;
+  if (nargs > kSmallArgs) {
+    big.resize(nargs);
+    args = big.data();
+  }
+  for (long i = 0; i < nargs; ++i)
+    args[i] = eval(n->kids[i + 1], env);
+  if (!f.is(Tag::Primitive)) throw_to_continuation(f, args, static_cast<int>(nargs));
+  return call_primitive(f, args, nargs, n->loc);
+}
+
 Value eval(Node *n, Frame *env) {
   check_stack(n->loc);
   for (;;) {
@@ -259,32 +290,13 @@ Value eval(Node *n, Frame *env) {
             fr->slots[i] = eval(n->kids[i + 1], env);
           env = fr;
         } else {
-          Value small[kSmallArgs];
-          gcvec<Value> big;
-          Value *args = small;
-          if (nargs > kSmallArgs) {
-            big.resize(nargs);
-            args = big.data();
-          }
-          for (long i = 0; i < nargs; ++i)
-            args[i] = eval(n->kids[i + 1], env);
-          env = bind_arguments(f, c, args, nargs, n->loc);
+          env = bind_evaluated(f, c, n, env);
         }
         n = lam->body;
         continue;
       }
       if (!f.is(Tag::Primitive) && !is_continuation(f)) not_applicable(f, n->loc);
-      Value small[kSmallArgs];
-      gcvec<Value> big;
-      Value *args = small;
-      if (nargs > kSmallArgs) {
-        big.resize(nargs);
-        args = big.data();
-      }
-      for (long i = 0; i < nargs; ++i)
-        args[i] = eval(n->kids[i + 1], env);
-      if (!f.is(Tag::Primitive)) throw_to_continuation(f, args, static_cast<int>(nargs));
-      return call_primitive(f, args, nargs, n->loc);
+      return call_evaluated(f, n, env);
     }
     }
     internal_failure(__FILE__, __LINE__, "unknown node kind");
