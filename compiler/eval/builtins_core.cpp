@@ -424,6 +424,7 @@ void install_core_primitives() {
   define_primitive("promise?", 1, 1, P_promise_p);
 
   define_primitive("apply", 1, kVariadic, P_apply);
+  register_apply_primitive(intern("apply").symbol()->global);
   define_primitive("values", 0, kVariadic, P_values);
   define_primitive("call-with-values", 2, 2, P_call_with_values);
   define_primitive("force", 1, 1, P_force);

@@ -19,6 +19,7 @@ namespace sicm {
 namespace {
 char *g_stack_limit = nullptr;
 SrcLoc g_call_loc;
+const void *g_apply_primitive = nullptr; // the `apply` primitive, called in tail position
 
 // Evaluate operands into a buffer; small calls use the C++ stack.
 constexpr int kSmallArgs = 8;
@@ -138,6 +139,8 @@ Frame *make_frame(Frame *parent, uint32_t size) {
   return f;
 }
 
+void register_apply_primitive(Value apply) { g_apply_primitive = apply.p; }
+
 SrcLoc current_call_loc() {
   return g_call_loc;
 }
@@ -193,6 +196,42 @@ Value apply_procedure(Value proc, Value *args, int nargs) {
     args[i] = eval(n->kids[i + 1], env);
   if (!f.is(Tag::Primitive)) throw_to_continuation(f, args, static_cast<int>(nargs));
   return call_primitive(f, args, nargs, n->loc);
+}
+
+// (apply f a ... list) must be a proper tail call: when f is a closure,
+// eval continues with its body instead of recursing.
+struct TailApply {
+  Value result;         // when the call is complete
+  Node *body = nullptr; // else: continue with body in env
+  Frame *env = nullptr;
+};
+
+[[gnu::noinline]] TailApply eval_apply(Value apply, Node *n, Frame *env) {
+  long nargs = n->nkids - 1;
+  if (nargs < 1) arity_error(apply, nargs, 1, -1, n->loc);
+  gcvec<Value> args;
+  Value target = eval(n->kids[1], env);
+  for (long i = 2; i < nargs; ++i)
+    args.push_back(eval(n->kids[i], env));
+  if (nargs > 1) {
+    Value last = eval(n->kids[nargs], env);
+    if (list_length(last) < 0) {
+      g_call_loc = n->loc;
+      wrong_type(last, static_cast<int>(nargs), "apply");
+    }
+    for (; is_pair(last); last = cdr(last))
+      args.push_back(car(last));
+  }
+  TailApply t;
+  if (target.is(Tag::Closure)) {
+    Closure *c = target.as<Closure>();
+    t.env = bind_arguments(target, c, args.data(), static_cast<long>(args.size()), n->loc);
+    t.body = c->lambda->body;
+    return t;
+  }
+  g_call_loc = n->loc;
+  t.result = apply_procedure(target, args.data(), static_cast<int>(args.size()));
+  return t;
 }
 
 Value eval(Node *n, Frame *env) {
@@ -296,6 +335,13 @@ Value eval(Node *n, Frame *env) {
         continue;
       }
       if (!f.is(Tag::Primitive) && !is_continuation(f)) not_applicable(f, n->loc);
+      if (f.p == g_apply_primitive) {
+        TailApply t = eval_apply(f, n, env);
+        if (!t.body) return t.result;
+        n = t.body;
+        env = t.env;
+        continue;
+      }
       return call_evaluated(f, n, env);
     }
     }

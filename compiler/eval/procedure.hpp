@@ -68,6 +68,9 @@ Frame *make_frame(Frame *parent, uint32_t size);
 
 // Apply any procedure to arguments (used by primitives such as map, apply, sort).
 Value apply_procedure(Value proc, Value *args, int nargs);
+// Tell the evaluator which primitive is `apply`, so calls to it are tail calls.
+void register_apply_primitive(Value apply);
+
 // Force a promise (other values are returned as they are).
 Value force_promise(Value v);
 inline bool is_procedure(Value v) {
