@@ -139,7 +139,9 @@ Frame *make_frame(Frame *parent, uint32_t size) {
   return f;
 }
 
-void register_apply_primitive(Value apply) { g_apply_primitive = apply.p; }
+void register_apply_primitive(Value apply) {
+  g_apply_primitive = apply.p;
+}
 
 SrcLoc current_call_loc() {
   return g_call_loc;
@@ -160,6 +162,10 @@ Value apply_procedure(Value proc, Value *args, int nargs) {
   if (proc.is(Tag::Primitive)) return call_primitive(proc, args, nargs, g_call_loc);
   if (!proc.is(Tag::Closure)) {
     if (is_continuation(proc)) throw_to_continuation(proc, args, nargs);
+    if (is_applicable_opaque(proc)) {
+      Opaque *o = proc.as<Opaque>();
+      return o->kind->apply(o->obj, args, nargs);
+    }
     not_applicable(proc, g_call_loc);
   }
   Closure *c = proc.as<Closure>();
@@ -194,6 +200,11 @@ Value apply_procedure(Value proc, Value *args, int nargs) {
   }
   for (long i = 0; i < nargs; ++i)
     args[i] = eval(n->kids[i + 1], env);
+  if (is_applicable_opaque(f)) {
+    g_call_loc = n->loc;
+    Opaque *o = f.as<Opaque>();
+    return o->kind->apply(o->obj, args, static_cast<int>(nargs));
+  }
   if (!f.is(Tag::Primitive)) throw_to_continuation(f, args, static_cast<int>(nargs));
   return call_primitive(f, args, nargs, n->loc);
 }
@@ -334,7 +345,8 @@ Value eval(Node *n, Frame *env) {
         n = lam->body;
         continue;
       }
-      if (!f.is(Tag::Primitive) && !is_continuation(f)) not_applicable(f, n->loc);
+      if (!f.is(Tag::Primitive) && !is_continuation(f) && !is_applicable_opaque(f))
+        not_applicable(f, n->loc);
       if (f.p == g_apply_primitive) {
         TailApply t = eval_apply(f, n, env);
         if (!t.body) return t.result;

@@ -73,8 +73,11 @@ void register_apply_primitive(Value apply);
 
 // Force a promise (other values are returned as they are).
 Value force_promise(Value v);
+inline bool is_applicable_opaque(Value v) {
+  return v.is(Tag::Opaque) && v.as<Opaque>()->kind->apply != nullptr;
+}
 inline bool is_procedure(Value v) {
-  return v.is(Tag::Closure) || v.is(Tag::Primitive);
+  return v.is(Tag::Closure) || v.is(Tag::Primitive) || is_applicable_opaque(v);
 }
 
 // Analyze a datum (with the position of the whole form) in the global scope.

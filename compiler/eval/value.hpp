@@ -42,6 +42,7 @@ enum class Tag : uint8_t {
   Char,        // a Unicode code point
   Fixnum,      // exact integer that fits in int64_t
   Flonum,      // IEEE double
+  Expr,        // a symbolic expression: an id (payload i) into the algebra's DAG
   // heap objects
   Bignum,    // exact integer outside int64_t (GMP mpz)
   Ratnum,    // exact non-integer rational (GMP mpq), always in lowest terms
@@ -57,7 +58,9 @@ enum class Tag : uint8_t {
   RecordType,
   Environment, // a first-class environment (the-environment)
   Parameter,   // reserved for later issues
-  Opaque,      // extension objects of later layers (algebra, plots, ...)
+  Structure,   // an up or down tuple (algebra/structure.hpp)
+  Matrix,      // a matrix (algebra/structure.hpp)
+  Opaque,      // extension objects of later layers (operators, series, plots, ...)
 };
 
 struct Bignum;
@@ -211,10 +214,13 @@ struct Record {
   Value *fields;
 };
 
-// Extension objects for later layers: a tagged pointer with a kind name and a printer.
+// Extension objects for later layers: a tagged pointer with a kind name, a
+// printer and, for objects that act as procedures (sums of functions,
+// operators such as D), an apply function.
 struct OpaqueKind {
   const char *name;
   void (*write)(std::string &out, const void *obj, bool display);
+  Value (*apply)(void *obj, Value *args, int nargs); // null: not applicable
 };
 struct Opaque {
   const OpaqueKind *kind;

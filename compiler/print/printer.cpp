@@ -95,7 +95,13 @@ void print_procedure(std::string &out, Value v) {
   out += ']';
 }
 
+DatumConverter g_converters[256] = {};
+
 } // namespace
+
+void set_datum_converter(Tag tag, DatumConverter convert) {
+  g_converters[static_cast<uint8_t>(tag)] = convert;
+}
 
 void print_value(std::string &out, Value v, bool display) {
   switch (v.tag) {
@@ -181,6 +187,16 @@ void print_value(std::string &out, Value v, bool display) {
     return;
   case Tag::Environment: out += "#[environment " + std::to_string(object_hash(v.p)) + "]"; return;
   case Tag::Parameter: out += "#[parameter " + std::to_string(object_hash(v.p)) + "]"; return;
+  case Tag::Expr:
+  case Tag::Structure:
+  case Tag::Matrix: {
+    DatumConverter convert = g_converters[static_cast<uint8_t>(v.tag)];
+    if (convert)
+      print_value(out, convert(v), display);
+    else
+      out += "#[" + std::string(v.is(Tag::Expr) ? "expression" : "structure") + "]";
+    return;
+  }
   case Tag::Opaque: {
     Opaque *o = v.as<Opaque>();
     o->kind->write(out, o->obj, display);

@@ -9,6 +9,11 @@
 namespace sicm {
 
 void print_value(std::string &out, Value v, bool display);
+
+// Later layers print their values by converting them to a datum first
+// (an expression to its simplified prefix form, (up 1 2) for a structure).
+using DatumConverter = Value (*)(Value v);
+void set_datum_converter(Tag tag, DatumConverter convert);
 std::string write_string(Value v);
 std::string display_string(Value v);
 

@@ -1,0 +1,59 @@
+// The bridge between generic arithmetic (eval/) and the expression algebra
+// (algebra/): how Scheme values become symbolic expressions and back.
+//
+// A symbolic value is a Value with Tag::Expr whose payload is an ExprId into
+// the hash-consed expression DAG (algebra/expr.hpp). Quoted symbols used as
+// numbers ('m, 'theta) are literal real numbers: arithmetic on them builds
+// expressions.
+#pragma once
+
+#include <cstdint>
+
+#include "eval/value.hpp"
+
+namespace sicm {
+
+enum class Op : uint8_t {
+#define SICM_OP(name, scheme, arity, c) name,
+#include "algebra/ops.def"
+#undef SICM_OP
+};
+
+struct OpInfo {
+  const char *scheme_name;
+  int arity; // -1: n-ary
+  const char *c_name;
+};
+const OpInfo &op_info(Op op);
+
+// A Value is "symbolic" if it is an expression or a symbol (a literal number).
+inline bool is_expression(Value v) {
+  return v.is(Tag::Expr);
+}
+inline bool is_symbolic(Value v) {
+  return v.is(Tag::Expr) || v.is(Tag::Symbol);
+}
+
+// Apply an algebraic operator to arguments that are numbers, symbols or
+// expressions. Folds exactly when every argument is a number; otherwise
+// returns an expression (Tag::Expr). Cheap local rewrites only (x+0, x*1,
+// x*0 with exact 0); full simplification is simplify_value's job.
+Value symbolic_apply(Op op, const Value *args, int nargs);
+
+// Apply an unknown function (a literal function's name, or an expression
+// denoting a derived function such as (D f)) to arguments: the expression (f t).
+Value symbolic_call(Value head, const Value *args, int nargs);
+
+// The simplified form: a number if the expression is one, else an expression.
+Value simplify_value(Value v);
+
+// The prefix form as a Scheme datum ((* 1/2 m (expt v 2)) as a list), in the
+// book's canonical order, of the simplified expression; numbers and symbols
+// are returned as they are.
+Value expression_to_datum(Value v);
+
+// Register the algebra's primitives (simplify, print-expression, pe,
+// expression->datum ...). Called by init_interpreter.
+void install_algebra_primitives();
+
+} // namespace sicm
