@@ -81,7 +81,9 @@ check: deps
 
 demo: deps
 	@$(MAKE) --no-print-directory all
-	$(SICM) run examples/demo.sicm
+	@mkdir -p $(BUILD)/demo
+	$(SICM) run examples/demo.sicm --plot-dir $(BUILD)/demo
+	@echo "plot: $(BUILD)/demo/driven-pendulum.svg (data: $(BUILD)/demo/driven-pendulum.tsv)"
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/sicm

@@ -10,6 +10,7 @@
 
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
+#include "eval/plot.hpp"
 #include "eval/procedure.hpp"
 #include "repl/repl.hpp"
 #include "syntax/error.hpp"
@@ -26,7 +27,9 @@ constexpr size_t kEvalStackBytes = size_t(256) << 20;  // reserved; pages are to
 constexpr size_t kStackGuardMargin = size_t(16) << 20; // kept free for primitives
 
 const char kUsage[] =
-    "usage: sicm run FILE        evaluate a program, printing each top-level value\n"
+    "usage: sicm run FILE [--plot-dir DIR]\n"
+    "                            evaluate a program, printing each top-level value;\n"
+    "                            plots (frame ...) are written to DIR (default .)\n"
     "       sicm repl            interactive read-eval-print loop\n"
     "       sicm --version\n";
 
@@ -64,11 +67,22 @@ int dispatch(const std::vector<std::string> &args) {
     return 0;
   }
   if (cmd == "run") {
-    if (args.size() != 2) {
+    std::string file;
+    for (size_t i = 1; i < args.size(); ++i) {
+      if (args[i] == "--plot-dir" && i + 1 < args.size()) {
+        sicm::set_plot_directory(args[++i]);
+      } else if (file.empty() && args[i].rfind("--", 0) != 0) {
+        file = args[i];
+      } else {
+        std::fputs(kUsage, stderr);
+        return kExitUsage;
+      }
+    }
+    if (file.empty()) {
       std::fputs(kUsage, stderr);
       return kExitUsage;
     }
-    return run_file(args[1]);
+    return run_file(file);
   }
   std::fprintf(stderr, "sicm: unknown command '%s'\n%s", cmd.c_str(), kUsage);
   return kExitUsage;

@@ -9,6 +9,7 @@
 #include "eval/builtins.hpp"
 #include "eval/core.hpp"
 #include "eval/number.hpp"
+#include "eval/plot.hpp"
 #include "eval/procedure.hpp"
 #include "eval/stdlib.hpp"
 #include "print/printer.hpp"
@@ -72,6 +73,7 @@ void init_interpreter() {
   install_number_primitives();
   install_text_primitives();
   install_vector_primitives();
+  install_plot_primitives();
   load_embedded_stdlib();
 }
 

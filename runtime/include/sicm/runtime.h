@@ -31,6 +31,32 @@ size_t sicm_format_double(char *buf, double x);
  * d1.d2...dn * 10^(*exponent10). x must be finite and non-zero. Returns n. */
 size_t sicm_shortest_digits(char *digits, int *exponent10, double x);
 
+/* ---- plot files ----------------------------------------------------------
+ * A plot is a frame [xmin, xmax] x [ymin, ymax] that collects points and line
+ * segments. sicm_plot_open creates DIR/NAME.tsv at once and appends every
+ * point to it as it arrives; sicm_plot_finish closes the TSV and writes
+ * DIR/NAME.svg (axes, ticks, labels, the marks inside the frame) atomically:
+ * to NAME.svg.tmp, then renamed. Every plot still open is finished at exit
+ * and on SIGINT/SIGTERM (the process then exits 128+signal), so an
+ * interrupted run keeps every point it produced. Functions return 0 on
+ * success and -1 with errno set on failure. */
+typedef struct sicm_plot sicm_plot;
+
+/* Open a plot; dir NULL means ".", title NULL means name. NULL on failure
+ * (errno EINVAL for an empty range). */
+sicm_plot *sicm_plot_open(const char *dir, const char *name, const char *title, double xmin,
+                          double xmax, double ymin, double ymax);
+int sicm_plot_point(sicm_plot *p, double x, double y);
+int sicm_plot_line(sicm_plot *p, double x0, double y0, double x1, double y1);
+/* Number of marks (points and segments) added so far. */
+size_t sicm_plot_count(const sicm_plot *p);
+/* Write the SVG and close the TSV; later marks are refused. Idempotent. */
+int sicm_plot_finish(sicm_plot *p);
+/* Finish (if needed) and release a plot. */
+void sicm_plot_free(sicm_plot *p);
+/* Finish every open plot (called at exit and on SIGINT/SIGTERM). */
+void sicm_plot_close_all(void);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,317 @@
+/* Plot files: every frame becomes NAME.tsv (the raw points, written as the
+ * run goes) and NAME.svg (axes, ticks, labels, points), finished when the
+ * frame is closed, at exit, or on SIGINT/SIGTERM.
+ *
+ * Nothing is lost on interruption: points are kept in memory and appended to
+ * the TSV file as they arrive (flushed at least every kFlushEvery points and
+ * on close); the SVG is written to NAME.svg.tmp and renamed over NAME.svg, so
+ * a crash never leaves a half-written picture where the last good one was. */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "sicm/runtime.h"
+
+enum { kFlushEvery = 4096, kMaxOpenPlots = 256 };
+
+typedef struct {
+  double x0, y0, x1, y1; /* a point has x1 = NAN */
+} mark;
+
+struct sicm_plot {
+  char *path;  /* NAME without extension, in its directory */
+  char *title; /* shown above the picture */
+  double xmin, xmax, ymin, ymax;
+  FILE *tsv;
+  mark *marks;
+  size_t n, cap;
+  size_t unflushed;
+  int closed;
+};
+
+static sicm_plot *open_plots[kMaxOpenPlots];
+static int handlers_installed;
+
+static void remember(sicm_plot *p) {
+  for (int i = 0; i < kMaxOpenPlots; ++i)
+    if (!open_plots[i]) {
+      open_plots[i] = p;
+      return;
+    }
+}
+
+static void forget(sicm_plot *p) {
+  for (int i = 0; i < kMaxOpenPlots; ++i)
+    if (open_plots[i] == p) open_plots[i] = NULL;
+}
+
+static void on_signal(int sig) {
+  /* Finishing the files here is not strictly async-signal-safe (stdio), but
+   * the alternative, losing the picture of an hours-long run, is worse; the
+   * process exits right after. */
+  sicm_plot_close_all();
+  _exit(128 + sig);
+}
+
+static void on_exit_finish(void) {
+  sicm_plot_close_all();
+}
+
+static void install_handlers(void) {
+  if (handlers_installed) return;
+  handlers_installed = 1;
+  atexit(on_exit_finish);
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+}
+
+static char *dup_string(const char *s) {
+  size_t n = strlen(s) + 1;
+  char *d = malloc(n);
+  if (d) memcpy(d, s, n);
+  return d;
+}
+
+sicm_plot *sicm_plot_open(const char *dir, const char *name, const char *title, double xmin,
+                          double xmax, double ymin, double ymax) {
+  if (!(xmax > xmin) || !(ymax > ymin)) {
+    errno = EINVAL;
+    return NULL;
+  }
+  sicm_plot *p = calloc(1, sizeof *p);
+  if (!p) return NULL;
+  size_t len = strlen(dir ? dir : ".") + strlen(name) + 2;
+  p->path = malloc(len);
+  p->title = dup_string(title ? title : name);
+  if (!p->path || !p->title) {
+    free(p->path);
+    free(p->title);
+    free(p);
+    return NULL;
+  }
+  snprintf(p->path, len, "%s/%s", dir ? dir : ".", name);
+  p->xmin = xmin;
+  p->xmax = xmax;
+  p->ymin = ymin;
+  p->ymax = ymax;
+  char tsv_path[4096];
+  snprintf(tsv_path, sizeof tsv_path, "%s.tsv", p->path);
+  p->tsv = fopen(tsv_path, "w");
+  if (!p->tsv) {
+    free(p->path);
+    free(p->title);
+    free(p);
+    return NULL;
+  }
+  fprintf(p->tsv, "# %s\n# x\ty\n", p->title);
+  fflush(p->tsv);
+  install_handlers();
+  remember(p);
+  return p;
+}
+
+static int add_mark(sicm_plot *p, mark m) {
+  if (p->closed) {
+    errno = EINVAL;
+    return -1;
+  }
+  if (p->n == p->cap) {
+    size_t cap = p->cap ? 2 * p->cap : 1024;
+    mark *grown = realloc(p->marks, cap * sizeof *grown);
+    if (!grown) return -1;
+    p->marks = grown;
+    p->cap = cap;
+  }
+  p->marks[p->n++] = m;
+  return 0;
+}
+
+static void write_tsv_number(FILE *f, double x) {
+  char buf[SICM_DOUBLE_BUFSIZE];
+  /* The TSV holds plain C numbers (0.5, not MIT's .5) so any tool reads it. */
+  snprintf(buf, sizeof buf, "%.17g", x);
+  fputs(buf, f);
+}
+
+static void after_write(sicm_plot *p) {
+  if (++p->unflushed >= kFlushEvery) {
+    fflush(p->tsv);
+    p->unflushed = 0;
+  }
+}
+
+int sicm_plot_point(sicm_plot *p, double x, double y) {
+  mark m = {x, y, NAN, NAN};
+  if (add_mark(p, m) != 0) return -1;
+  write_tsv_number(p->tsv, x);
+  fputc('\t', p->tsv);
+  write_tsv_number(p->tsv, y);
+  fputc('\n', p->tsv);
+  after_write(p);
+  return 0;
+}
+
+int sicm_plot_line(sicm_plot *p, double x0, double y0, double x1, double y1) {
+  mark m = {x0, y0, x1, y1};
+  if (add_mark(p, m) != 0) return -1;
+  write_tsv_number(p->tsv, x0);
+  fputc('\t', p->tsv);
+  write_tsv_number(p->tsv, y0);
+  fputc('\t', p->tsv);
+  write_tsv_number(p->tsv, x1);
+  fputc('\t', p->tsv);
+  write_tsv_number(p->tsv, y1);
+  fputc('\n', p->tsv);
+  after_write(p);
+  return 0;
+}
+
+/* ---- the SVG picture ---------------------------------------------------- */
+
+enum { kWidth = 640, kHeight = 480, kLeft = 70, kRight = 20, kTop = 40, kBottom = 50 };
+
+static double px(const sicm_plot *p, double x) {
+  return kLeft + (x - p->xmin) / (p->xmax - p->xmin) * (kWidth - kLeft - kRight);
+}
+static double py(const sicm_plot *p, double y) {
+  return kHeight - kBottom - (y - p->ymin) / (p->ymax - p->ymin) * (kHeight - kTop - kBottom);
+}
+
+/* A "nice" tick spacing: 1, 2 or 5 times a power of ten, about 5-10 ticks. */
+static double tick_step(double span) {
+  double raw = span / 6.0;
+  double mag = pow(10.0, floor(log10(raw)));
+  double f = raw / mag;
+  return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * mag;
+}
+
+static void write_escaped(FILE *f, const char *s) {
+  for (; *s; ++s) {
+    switch (*s) {
+    case '<': fputs("&lt;", f); break;
+    case '>': fputs("&gt;", f); break;
+    case '&': fputs("&amp;", f); break;
+    case '"': fputs("&quot;", f); break;
+    default: fputc(*s, f);
+    }
+  }
+}
+
+static void write_ticks(FILE *f, const sicm_plot *p) {
+  char label[SICM_DOUBLE_BUFSIZE];
+  double step = tick_step(p->xmax - p->xmin);
+  for (double t = ceil(p->xmin / step) * step; t <= p->xmax + step * 1e-9; t += step) {
+    double x = px(p, t), y0 = kHeight - kBottom;
+    sicm_format_double(label, fabs(t) < step * 1e-9 ? 0.0 : t);
+    fprintf(f, "<line x1=\"%.2f\" y1=\"%d\" x2=\"%.2f\" y2=\"%d\" stroke=\"black\"/>\n", x, (int)y0,
+            x, (int)y0 + 5);
+    fprintf(f, "<text x=\"%.2f\" y=\"%d\" text-anchor=\"middle\">%s</text>\n", x, (int)y0 + 20,
+            label);
+  }
+  step = tick_step(p->ymax - p->ymin);
+  for (double t = ceil(p->ymin / step) * step; t <= p->ymax + step * 1e-9; t += step) {
+    double y = py(p, t);
+    sicm_format_double(label, fabs(t) < step * 1e-9 ? 0.0 : t);
+    fprintf(f, "<line x1=\"%d\" y1=\"%.2f\" x2=\"%d\" y2=\"%.2f\" stroke=\"black\"/>\n", kLeft - 5,
+            y, kLeft, y);
+    fprintf(f, "<text x=\"%d\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", kLeft - 8, y + 4,
+            label);
+  }
+}
+
+static int inside(const sicm_plot *p, double x, double y) {
+  return x >= p->xmin && x <= p->xmax && y >= p->ymin && y <= p->ymax;
+}
+
+static void write_marks(FILE *f, const sicm_plot *p) {
+  /* All points as one path of zero-length segments with round caps: small
+   * files and fast rendering even for hundreds of thousands of points. */
+  fputs("<path fill=\"none\" stroke=\"#1f4e99\" stroke-width=\"2\" stroke-linecap=\"round\" d=\"",
+        f);
+  for (size_t i = 0; i < p->n; ++i) {
+    const mark *m = &p->marks[i];
+    if (!isnan(m->x1) || !inside(p, m->x0, m->y0)) continue;
+    fprintf(f, "M%.2f %.2fh0", px(p, m->x0), py(p, m->y0));
+  }
+  fputs("\"/>\n", f);
+  for (size_t i = 0; i < p->n; ++i) {
+    const mark *m = &p->marks[i];
+    if (isnan(m->x1)) continue;
+    fprintf(f,
+            "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#b33\" "
+            "stroke-width=\"1\"/>\n",
+            px(p, m->x0), py(p, m->y0), px(p, m->x1), py(p, m->y1));
+  }
+}
+
+static int write_svg(const sicm_plot *p) {
+  char tmp[4096], final[4096];
+  snprintf(tmp, sizeof tmp, "%s.svg.tmp", p->path);
+  snprintf(final, sizeof final, "%s.svg", p->path);
+  FILE *f = fopen(tmp, "w");
+  if (!f) return -1;
+  fprintf(f,
+          "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+          "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
+          "viewBox=\"0 0 %d %d\" font-family=\"sans-serif\" font-size=\"12\">\n"
+          "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+          kWidth, kHeight, kWidth, kHeight);
+  fprintf(f, "<text x=\"%d\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">", kWidth / 2);
+  write_escaped(f, p->title);
+  fputs("</text>\n", f);
+  fprintf(f,
+          "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"black\"/>\n",
+          kLeft, kTop, kWidth - kLeft - kRight, kHeight - kTop - kBottom);
+  fprintf(
+      f, "<clipPath id=\"frame\"><rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\"/></clipPath>\n",
+      kLeft, kTop, kWidth - kLeft - kRight, kHeight - kTop - kBottom);
+  write_ticks(f, p);
+  fputs("<g clip-path=\"url(#frame)\">\n", f);
+  write_marks(f, p);
+  fputs("</g>\n</svg>\n", f);
+  int ok = ferror(f) == 0;
+  if (fclose(f) != 0) ok = 0;
+  if (!ok || rename(tmp, final) != 0) {
+    remove(tmp);
+    return -1;
+  }
+  return 0;
+}
+
+int sicm_plot_finish(sicm_plot *p) {
+  if (p->closed) return 0;
+  p->closed = 1;
+  int status = 0;
+  if (fclose(p->tsv) != 0) status = -1;
+  p->tsv = NULL;
+  if (write_svg(p) != 0) status = -1;
+  return status;
+}
+
+void sicm_plot_free(sicm_plot *p) {
+  if (!p) return;
+  sicm_plot_finish(p);
+  forget(p);
+  free(p->marks);
+  free(p->path);
+  free(p->title);
+  free(p);
+}
+
+void sicm_plot_close_all(void) {
+  for (int i = 0; i < kMaxOpenPlots; ++i)
+    if (open_plots[i]) sicm_plot_finish(open_plots[i]);
+}
+
+size_t sicm_plot_count(const sicm_plot *p) {
+  return p->n;
+}

@@ -1,0 +1,86 @@
+// Unit tests of the runtime's plot files: TSV as the run goes, SVG on finish,
+// atomic replacement, bad ranges refused.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "sicm/runtime.h"
+
+namespace {
+
+std::string slurp(const std::string &path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+bool exists(const std::string &path) {
+  struct stat st;
+  return stat(path.c_str(), &st) == 0;
+}
+
+std::string temp_dir() {
+  char tmpl[] = "/tmp/sicm-plot-XXXXXX";
+  return mkdtemp(tmpl);
+}
+
+} // namespace
+
+TEST(Plot, TsvHoldsEveryPointBeforeFinish) {
+  std::string dir = temp_dir();
+  sicm_plot *p = sicm_plot_open(dir.c_str(), "p", "a title", 0, 1, -1, 1);
+  ASSERT_NE(p, nullptr);
+  for (int i = 0; i < 5000; ++i)
+    ASSERT_EQ(sicm_plot_point(p, i / 5000.0, 0.5), 0);
+  // Not finished yet: the flushed part of the TSV is already on disk.
+  std::string early = slurp(dir + "/p.tsv");
+  EXPECT_GE(std::count(early.begin(), early.end(), '\n'), 4096);
+  EXPECT_FALSE(exists(dir + "/p.svg"));
+  ASSERT_EQ(sicm_plot_finish(p), 0);
+  std::string tsv = slurp(dir + "/p.tsv");
+  EXPECT_EQ(std::count(tsv.begin(), tsv.end(), '\n'), 5000 + 2); // two header lines
+  EXPECT_EQ(sicm_plot_count(p), 5000u);
+  sicm_plot_free(p);
+}
+
+TEST(Plot, SvgIsCompleteAndReplacedAtomically) {
+  std::string dir = temp_dir();
+  for (int round = 0; round < 2; ++round) {
+    sicm_plot *p = sicm_plot_open(dir.c_str(), "q", "x<y & \"z\"", -3, 3, 0, 10);
+    ASSERT_NE(p, nullptr);
+    sicm_plot_point(p, 1, 5);
+    sicm_plot_point(p, 100, 5); // outside the frame: in the TSV, not drawn
+    sicm_plot_line(p, -3, 0, 3, 10);
+    sicm_plot_free(p);
+  }
+  std::string svg = slurp(dir + "/q.svg");
+  EXPECT_EQ(svg.rfind("<?xml", 0), 0u);
+  EXPECT_NE(svg.find("</svg>\n"), std::string::npos);
+  EXPECT_NE(svg.find("x&lt;y &amp; &quot;z&quot;"), std::string::npos); // title escaped
+  EXPECT_NE(svg.find("<line"), std::string::npos);
+  EXPECT_FALSE(exists(dir + "/q.svg.tmp"));
+  std::string tsv = slurp(dir + "/q.tsv");
+  EXPECT_NE(tsv.find("100\t5\n"), std::string::npos);
+}
+
+TEST(Plot, EmptyRangesAreRefused) {
+  std::string dir = temp_dir();
+  EXPECT_EQ(sicm_plot_open(dir.c_str(), "r", nullptr, 1, 1, 0, 1), nullptr);
+  EXPECT_EQ(sicm_plot_open(dir.c_str(), "r", nullptr, 0, 1, 2, 1), nullptr);
+}
+
+TEST(Plot, MarksAfterFinishAreRefused) {
+  std::string dir = temp_dir();
+  sicm_plot *p = sicm_plot_open(dir.c_str(), "s", nullptr, 0, 1, 0, 1);
+  ASSERT_NE(p, nullptr);
+  sicm_plot_finish(p);
+  EXPECT_EQ(sicm_plot_point(p, 0.5, 0.5), -1);
+  sicm_plot_free(p);
+}
