@@ -57,6 +57,13 @@ size_t arg_index(Value *args, int i, const char *who) {
   return static_cast<size_t>(args[i].i);
 }
 
+size_t arg_bounded(Value *args, int i, size_t lo, size_t hi, const char *who) {
+  if (!args[i].is(Tag::Fixnum)) wrong_type(args[i], i + 1, who);
+  if (args[i].i < 0 || static_cast<size_t>(args[i].i) < lo || static_cast<size_t>(args[i].i) > hi)
+    bad_range(args[i], i + 1, who);
+  return static_cast<size_t>(args[i].i);
+}
+
 std::string_view arg_string(Value *args, int i, const char *who) {
   if (!args[i].is(Tag::String)) wrong_type(args[i], i + 1, who);
   return string_view(args[i]);

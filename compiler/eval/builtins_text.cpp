@@ -14,6 +14,7 @@
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
+#include "syntax/utf8.hpp"
 
 namespace sicm {
 
@@ -21,43 +22,9 @@ namespace {
 
 // ---- UTF-8 -------------------------------------------------------------------
 
-void put_utf8(std::string &out, uint32_t cp) {
-  if (cp < 0x80) {
-    out += static_cast<char>(cp);
-  } else if (cp < 0x800) {
-    out += static_cast<char>(0xC0 | (cp >> 6));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else if (cp < 0x10000) {
-    out += static_cast<char>(0xE0 | (cp >> 12));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else {
-    out += static_cast<char>(0xF0 | (cp >> 18));
-    out += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  }
-}
-
-// The character whose encoding starts at s[pos]; *n receives its length in
-// bytes. A byte that does not start a well-formed sequence stands for itself,
-// so every byte string reads as some characters.
+// The character whose encoding starts at s[pos]; *n receives its length in bytes.
 uint32_t get_utf8(std::string_view s, size_t pos, size_t *n) {
-  auto b = [&](size_t i) { return static_cast<unsigned char>(s[i]); };
-  unsigned char c = b(pos);
-  *n = 1;
-  size_t extra = c >= 0xF0 && c < 0xF5   ? 3
-                 : c >= 0xE0 && c < 0xF0 ? 2
-                 : c >= 0xC2 && c < 0xE0 ? 1
-                                         : 0;
-  if (extra == 0 || pos + extra >= s.size()) return c;
-  uint32_t cp = c & (0x3F >> extra);
-  for (size_t k = 1; k <= extra; ++k) {
-    if ((b(pos + k) & 0xC0) != 0x80) return c;
-    cp = (cp << 6) | (b(pos + k) & 0x3F);
-  }
-  *n = 1 + extra;
-  return cp;
+  return decode_utf8(s.substr(pos), *n);
 }
 
 // ---- arguments ---------------------------------------------------------------
@@ -80,14 +47,6 @@ String *arg_str(Value *args, int i, const char *who) {
 size_t arg_count(Value *args, int i, const char *who) {
   if (!args[i].is(Tag::Fixnum) || args[i].i < 0) wrong_type(args[i], i + 1, who);
   if (args[i].i > (int64_t{1} << 31)) bad_range(args[i], i + 1, who);
-  return static_cast<size_t>(args[i].i);
-}
-
-// An index in [lo, hi]: not a fixnum is a wrong type, outside the bounds a bad range.
-size_t arg_bounded(Value *args, int i, size_t lo, size_t hi, const char *who) {
-  if (!args[i].is(Tag::Fixnum)) wrong_type(args[i], i + 1, who);
-  if (args[i].i < 0 || static_cast<size_t>(args[i].i) < lo || static_cast<size_t>(args[i].i) > hi)
-    bad_range(args[i], i + 1, who);
   return static_cast<size_t>(args[i].i);
 }
 
@@ -189,7 +148,7 @@ std::string fold_case(std::string_view s, bool up) {
     if (n == 1 && c >= 0x80)
       out += s[i]; // a stray byte stays as it is
     else
-      put_utf8(out, up ? upcase(c) : downcase(c));
+      append_utf8(out, up ? upcase(c) : downcase(c));
     i += n;
   }
   return out;
@@ -259,7 +218,7 @@ Value pad(Value *args, int nargs, bool left, const char *who) {
   if (n <= s.size()) return str(left ? s.substr(s.size() - n) : s.substr(0, n));
   std::string padding;
   for (size_t i = s.size(); i < n; ++i)
-    put_utf8(padding, fill);
+    append_utf8(padding, fill);
   return str(left ? padding + std::string(s) : std::string(s) + padding);
 }
 
@@ -327,7 +286,7 @@ void install_characters() {
   });
   define_primitive("char->string", 1, 1, [](Value *a, int) {
     std::string s;
-    put_utf8(s, arg_char(a, 0, "char->string"));
+    append_utf8(s, arg_char(a, 0, "char->string"));
     return str(s);
   });
 }
@@ -339,7 +298,7 @@ void install_strings() {
     uint32_t fill = supplied(a, n, 1) ? arg_char(a, 1, "make-string") : ' ';
     std::string s;
     for (size_t i = 0; i < k; ++i)
-      put_utf8(s, fill);
+      append_utf8(s, fill);
     return str(s);
   });
   define_primitive("string", 0, kVariadic,
@@ -362,7 +321,7 @@ void install_strings() {
     size_t pos = static_cast<size_t>(a[1].i), n;
     get_utf8(string_view(a[0]), pos, &n);
     std::string text;
-    put_utf8(text, c);
+    append_utf8(text, c);
     splice(s, pos, n, text);
     return Value::unspecified();
   });
@@ -407,7 +366,7 @@ void install_strings() {
     std::string out;
     for (Value p = a[0]; is_pair(p); p = cdr(p)) {
       if (!car(p).is(Tag::Char)) wrong_type(car(p), 1, "list->string");
-      put_utf8(out, car(p).ch);
+      append_utf8(out, car(p).ch);
     }
     return str(out);
   });

@@ -29,14 +29,6 @@ size_t arg_size(Value *args, int i, const char *who) {
   return static_cast<size_t>(args[i].i);
 }
 
-// An index in [lo, hi]: not a fixnum is a wrong type, outside the bounds a bad range.
-size_t arg_bounded(Value *args, int i, size_t lo, size_t hi, const char *who) {
-  if (!args[i].is(Tag::Fixnum)) wrong_type(args[i], i + 1, who);
-  if (args[i].i < 0 || static_cast<size_t>(args[i].i) < lo || static_cast<size_t>(args[i].i) > hi)
-    bad_range(args[i], i + 1, who);
-  return static_cast<size_t>(args[i].i);
-}
-
 // An element index of v: in [0, len).
 size_t arg_element(Value *args, int i, Vector *v, const char *who) {
   if (!args[i].is(Tag::Fixnum)) wrong_type(args[i], i + 1, who);

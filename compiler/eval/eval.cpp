@@ -175,10 +175,10 @@ Value apply_procedure(Value proc, Value *args, int nargs) {
 
 // The slower call paths live in their own functions, so that eval's own
 // stack frame stays small: its size is what deep recursion pays per level.
-[[gnu::noinline]] Frame *bind_evaluated(Value f, Closure *c, Node *n, Frame *env) {
+// Evaluate the operands of call node n into small (or big, when they do not
+// fit); returns where they are.
+Value *evaluate_operands(Node *n, Frame *env, Value (&small)[kSmallArgs], gcvec<Value> &big) {
   long nargs = n->nkids - 1;
-  Value small[kSmallArgs];
-  gcvec<Value> big;
   Value *args = small;
   if (nargs > kSmallArgs) {
     big.resize(nargs);
@@ -186,20 +186,21 @@ Value apply_procedure(Value proc, Value *args, int nargs) {
   }
   for (long i = 0; i < nargs; ++i)
     args[i] = eval(n->kids[i + 1], env);
-  return bind_arguments(f, c, args, nargs, n->loc);
+  return args;
+}
+
+[[gnu::noinline]] Frame *bind_evaluated(Value f, Closure *c, Node *n, Frame *env) {
+  Value small[kSmallArgs];
+  gcvec<Value> big;
+  Value *args = evaluate_operands(n, env, small, big);
+  return bind_arguments(f, c, args, n->nkids - 1, n->loc);
 }
 
 [[gnu::noinline]] Value call_evaluated(Value f, Node *n, Frame *env) {
   long nargs = n->nkids - 1;
   Value small[kSmallArgs];
   gcvec<Value> big;
-  Value *args = small;
-  if (nargs > kSmallArgs) {
-    big.resize(nargs);
-    args = big.data();
-  }
-  for (long i = 0; i < nargs; ++i)
-    args[i] = eval(n->kids[i + 1], env);
+  Value *args = evaluate_operands(n, env, small, big);
   if (is_applicable_opaque(f)) {
     g_call_loc = n->loc;
     Opaque *o = f.as<Opaque>();

@@ -34,6 +34,8 @@ void define_global(const char *name, Value v);
 // Argument checkers that return the unwrapped value or raise wrong_type.
 int64_t arg_fixnum(Value *args, int i, const char *who); // exact integer in int64 range
 size_t arg_index(Value *args, int i, const char *who);   // exact non-negative integer
+// An index in [lo, hi]: not a fixnum is a wrong type, outside the bounds a bad range.
+size_t arg_bounded(Value *args, int i, size_t lo, size_t hi, const char *who);
 std::string_view arg_string(Value *args, int i, const char *who);
 Symbol *arg_symbol(Value *args, int i, const char *who);
 

@@ -1,6 +1,8 @@
 // Printing values as MIT Scheme writes and displays them.
 #include "print/printer.hpp"
 
+#include "syntax/utf8.hpp"
+
 #include <unordered_map>
 
 #include "eval/number.hpp"
@@ -19,24 +21,6 @@ int object_hash(const void *p) {
   auto [it, inserted] = numbers->emplace(p, next);
   if (inserted) ++next;
   return it->second;
-}
-
-void append_utf8(std::string &out, uint32_t cp) {
-  if (cp < 0x80) {
-    out += static_cast<char>(cp);
-  } else if (cp < 0x800) {
-    out += static_cast<char>(0xC0 | (cp >> 6));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else if (cp < 0x10000) {
-    out += static_cast<char>(0xE0 | (cp >> 12));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else {
-    out += static_cast<char>(0xF0 | (cp >> 18));
-    out += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  }
 }
 
 void write_char(std::string &out, uint32_t c) {

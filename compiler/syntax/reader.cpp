@@ -4,6 +4,7 @@
 #include <cctype>
 
 #include "eval/number.hpp"
+#include "syntax/utf8.hpp"
 
 namespace sicm {
 
@@ -24,24 +25,6 @@ constexpr NamedChar kNamedChars[] = {
     {"return", '\r'}, {"linefeed", '\n'}, {"altmode", 27}, {"escape", 27}, {"backspace", 8},
     {"delete", 127},  {"rubout", 127},    {"alarm", 7},    {"page", 12},
 };
-
-// Decode one UTF-8 sequence starting at s; returns the code point and sets len.
-uint32_t decode_utf8(std::string_view s, size_t &len) {
-  unsigned char c = static_cast<unsigned char>(s[0]);
-  int n = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : (c >> 3) == 30 ? 4 : 1;
-  if (static_cast<size_t>(n) > s.size()) n = 1;
-  uint32_t cp = n == 1 ? c : n == 2 ? (c & 0x1f) : n == 3 ? (c & 0x0f) : (c & 0x07);
-  for (int i = 1; i < n; ++i) {
-    unsigned char cc = static_cast<unsigned char>(s[i]);
-    if ((cc >> 6) != 2) {
-      len = 1;
-      return c;
-    }
-    cp = (cp << 6) | (cc & 0x3f);
-  }
-  len = static_cast<size_t>(n);
-  return cp;
-}
 
 } // namespace
 

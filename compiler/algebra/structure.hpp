@@ -1,0 +1,83 @@
+// Up and down tuples (SICM's structures) and matrices: representation, shapes and linear algebra.
+//
+// A structure is an up (contravariant, "column") or down (covariant, "row")
+// tuple whose components are any values, structures included, so shapes nest:
+// (up t (up x y) (down p_x p_y)). A matrix is a rows x cols array of values
+// stored row-major. Both live on the collected heap (Tag::Structure,
+// Tag::Matrix) and are immutable once built.
+//
+// Arithmetic on them follows the book's appendix "Our Notation": a down times
+// an up of the same length contracts to the sum of the products of
+// components; any other product of structures multiplies the first factor
+// into each component of the second; sums are componentwise and need equal
+// shapes. The generic operations (algebra/generic.hpp) call in here through
+// the "structure" arithmetic type registered by register_structure_arith().
+#pragma once
+
+#include <cstddef>
+
+#include "eval/value.hpp"
+
+namespace sicm {
+
+struct Structure {
+  bool up;
+  Value *items; // GC memory, `len` components
+  size_t len;
+};
+
+struct Matrix {
+  size_t rows, cols;
+  Value *items; // GC memory, row-major: entry (i, j) is items[i * cols + j]
+};
+
+// ---- construction and access ----
+// A structure of len components, each initialized to #!unspecific; fill it
+// before it escapes.
+Value make_structure(bool up, size_t len);
+Value make_structure_from(bool up, const Value *items, size_t len);
+// A rows x cols matrix, entries initialized to exact 0.
+Value make_matrix(size_t rows, size_t cols);
+
+inline bool is_structure(Value v) {
+  return v.is(Tag::Structure);
+}
+inline bool is_matrix(Value v) {
+  return v.is(Tag::Matrix);
+}
+inline Structure *as_structure(Value v) {
+  return v.as<Structure>();
+}
+inline Matrix *as_matrix(Value v) {
+  return v.as<Matrix>();
+}
+inline Value &matrix_at(Matrix *m, size_t i, size_t j) {
+  return m->items[i * m->cols + j];
+}
+
+// ---- shapes ----
+// Number of scalar leaves of a (nested) structure; 1 for anything else.
+size_t structure_dimension(Value v);
+// The same shape with up and down exchanged at every level and every leaf
+// replaced by fill(i), i counting leaves in order.
+Value dual_shape(Value shape, Value (*fill)(size_t i, void *ctx), void *ctx);
+
+// ---- arithmetic on structures and matrices (operands already dispatched) ----
+// Contraction when a and b are structures compatible for it, else the first
+// factor times each component of the second.
+Value structure_mul(Value a, Value b);
+// The linear-algebra inverse of a square matrix, or of a structure of n
+// structures of length n viewed as a linear map (its components are the
+// columns). `who` names the caller in the "singular" error.
+Value matrix_inverse(Value m, const char *who);
+Value structure_inverse(Value s, const char *who);
+// Determinant of a square matrix or of a square structure of structures.
+Value determinant(Value m);
+
+// Register the structure and matrix arithmetic type with generic arithmetic,
+// and the structure and matrix primitives (up, down, ref, matrix-by-rows, ...),
+// and their printers.
+void register_structure_arith();
+void install_structure_primitives();
+
+} // namespace sicm
