@@ -1,4 +1,4 @@
-// Generic arithmetic: + - * / expt sin ... over numbers, symbolic values, structures, matrices and functions.
+// Generic arithmetic: + - * / sin ... over numbers, expressions, structures and functions.
 //
 // Numbers take a fast path straight into the numeric tower (eval/number.hpp).
 // Every other kind of value belongs to an *arithmetic type*: a row of a small
@@ -25,6 +25,7 @@
 #include <cstdint>
 
 #include "eval/number.hpp"
+#include "eval/procedure.hpp"
 #include "eval/value.hpp"
 
 namespace sicm {
@@ -67,8 +68,8 @@ const char *op_error_name(BinaryOp op);
 
 struct ArithType {
   const char *name;
-  int rank;                    // higher ranks handle mixed operations
-  bool (*member)(Value v);     // does v belong to this type?
+  int rank;                // higher ranks handle mixed operations
+  bool (*member)(Value v); // does v belong to this type?
   Value (*unary)(UnaryOp op, Value x);
   // Called when a or b is of this type and the other is of a type of rank
   // no higher (or a number, or no arithmetic value at all: then raise).
@@ -125,14 +126,16 @@ struct NativeProc;
 using NativeFn = Value (*)(NativeProc *self, Value *args, int nargs);
 struct NativeProc {
   NativeFn fn;
-  int op;           // an operation, for combinations
-  Value a, b;       // operands or captured data
-  Value *items;     // captured values (compose: the functions), GC memory
+  int op;       // an operation, for combinations
+  Value a, b;   // operands or captured data
+  Value *items; // captured values (compose: the functions), GC memory
   size_t nitems;
   Closure print_as; // gives the object its #[compound-procedure N] number
 };
 Value make_native_procedure(NativeFn fn, int op, Value a, Value b, const Value *items = nullptr,
                             size_t nitems = 0);
+// MIT's arity error for a NativeProc that takes exactly `required` arguments.
+[[noreturn]] void native_arity_error(NativeProc *self, int given, int required);
 // (compose f g ...): the procedure x... |-> (f (g ... x...)).
 Value compose_procedures(const Value *fs, size_t n);
 

@@ -58,9 +58,11 @@ inline Value &matrix_at(Matrix *m, size_t i, size_t j) {
 // ---- shapes ----
 // Number of scalar leaves of a (nested) structure; 1 for anything else.
 size_t structure_dimension(Value v);
-// The same shape with up and down exchanged at every level and every leaf
-// replaced by fill(i), i counting leaves in order.
-Value dual_shape(Value shape, Value (*fill)(size_t i, void *ctx), void *ctx);
+// The leaves of v in order (v itself if it is not a structure).
+void structure_leaves(Value v, gcvec<Value> &out);
+// A structure of the shape of `shape` (with up and down exchanged at every
+// level if `dual`) whose leaves are leaves[0 .. structure_dimension(shape)).
+Value shape_from_leaves(Value shape, bool dual, const Value *leaves);
 
 // ---- arithmetic on structures and matrices (operands already dispatched) ----
 // Contraction when a and b are structures compatible for it, else the first

@@ -44,6 +44,11 @@ Value symbolic_apply(Op op, const Value *args, int nargs);
 // denoting a derived function such as (D f)) to arguments: the expression (f t).
 Value symbolic_call(Value head, const Value *args, int nargs);
 
+// A prefix-form datum as an expression: ((D f) t) or (+ (* 2 x) 1), operators
+// of ops.def applied by symbolic_apply, other lists as functions applied to
+// arguments. Numbers and symbols are returned as they are.
+Value datum_to_expression(Value datum);
+
 // The simplified form: a number if the expression is one, else an expression.
 Value simplify_value(Value v);
 

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "algebra/structure.hpp"
 #include "eval/analyze.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
@@ -107,6 +108,20 @@ bool equal(Value a, Value b) {
       return true;
     }
     case Tag::Flonum: return a.d == b.d;
+    case Tag::Structure: {
+      Structure *x = a.as<Structure>(), *y = b.as<Structure>();
+      if (x->up != y->up || x->len != y->len) return false;
+      for (size_t i = 0; i < x->len; ++i)
+        if (!equal(x->items[i], y->items[i])) return false;
+      return true;
+    }
+    case Tag::Matrix: {
+      Matrix *x = a.as<Matrix>(), *y = b.as<Matrix>();
+      if (x->rows != y->rows || x->cols != y->cols) return false;
+      for (size_t i = 0; i < x->rows * x->cols; ++i)
+        if (!equal(x->items[i], y->items[i])) return false;
+      return true;
+    }
     default: return false;
     }
   }

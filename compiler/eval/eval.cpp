@@ -9,6 +9,7 @@
 // exceeded" instead of a segfault.
 #include <string>
 
+#include "algebra/structure.hpp"
 #include "eval/core.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
@@ -126,6 +127,17 @@ Value call_primitive(Value f, Value *args, long nargs, SrcLoc loc) {
   return p->fn(args, static_cast<int>(nargs));
 }
 
+// A structure of procedures applies componentwise, as in scmutils:
+// ((up sin cos) t) is (up (sin t) (cos t)).
+Value apply_structure(Value s, Value *args, int nargs) {
+  Structure *st = s.as<Structure>();
+  Structure *out = gc_new<Structure>(Structure{st->up, nullptr, st->len});
+  out->items = static_cast<Value *>(GC_MALLOC(sizeof(Value) * (st->len ? st->len : 1)));
+  for (size_t i = 0; i < st->len; ++i)
+    out->items[i] = apply_procedure(st->items[i], args, nargs);
+  return Value::object(Tag::Structure, out);
+}
+
 } // namespace
 
 Frame *make_frame(Frame *parent, uint32_t size) {
@@ -166,6 +178,7 @@ Value apply_procedure(Value proc, Value *args, int nargs) {
       Opaque *o = proc.as<Opaque>();
       return o->kind->apply(o->obj, args, nargs);
     }
+    if (proc.is(Tag::Structure)) return apply_structure(proc, args, nargs);
     not_applicable(proc, g_call_loc);
   }
   Closure *c = proc.as<Closure>();
@@ -205,6 +218,10 @@ Value *evaluate_operands(Node *n, Frame *env, Value (&small)[kSmallArgs], gcvec<
     g_call_loc = n->loc;
     Opaque *o = f.as<Opaque>();
     return o->kind->apply(o->obj, args, static_cast<int>(nargs));
+  }
+  if (f.is(Tag::Structure)) {
+    g_call_loc = n->loc;
+    return apply_structure(f, args, static_cast<int>(nargs));
   }
   if (!f.is(Tag::Primitive)) throw_to_continuation(f, args, static_cast<int>(nargs));
   return call_primitive(f, args, nargs, n->loc);
@@ -346,7 +363,8 @@ Value eval(Node *n, Frame *env) {
         n = lam->body;
         continue;
       }
-      if (!f.is(Tag::Primitive) && !is_continuation(f) && !is_applicable_opaque(f))
+      if (!f.is(Tag::Primitive) && !is_continuation(f) && !is_applicable_opaque(f) &&
+          !f.is(Tag::Structure))
         not_applicable(f, n->loc);
       if (f.p == g_apply_primitive) {
         TailApply t = eval_apply(f, n, env);

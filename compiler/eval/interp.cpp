@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <unordered_set>
 
+#include "algebra/generic.hpp"
+#include "algebra/symbolic.hpp"
 #include "eval/analyze.hpp"
 #include "eval/builtins.hpp"
 #include "eval/core.hpp"
@@ -12,6 +14,7 @@
 #include "eval/plot.hpp"
 #include "eval/procedure.hpp"
 #include "eval/stdlib.hpp"
+#include "print/infix.hpp"
 #include "print/printer.hpp"
 #include "syntax/reader.hpp"
 
@@ -74,6 +77,9 @@ void init_interpreter() {
   install_text_primitives();
   install_vector_primitives();
   install_plot_primitives();
+  install_show_primitives();
+  install_algebra_primitives();
+  install_generic_primitives();
   load_embedded_stdlib();
 }
 

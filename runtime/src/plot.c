@@ -5,11 +5,21 @@
  * Nothing is lost on interruption: points are kept in memory and appended to
  * the TSV file as they arrive (flushed at least every kFlushEvery points and
  * on close); the SVG is written to NAME.svg.tmp and renamed over NAME.svg, so
- * a crash never leaves a half-written picture where the last good one was. */
+ * a crash never leaves a half-written picture where the last good one was.
+ *
+ * Signals. A signal may arrive while a mark is being added (on this thread
+ * or, in the interpreter, on the evaluating thread while the handler runs on
+ * another). One atomic state word orders the two without locks:
+ *   IDLE -> BUSY      a plot operation starts (and IDLE again when it ends);
+ *   IDLE -> CLOSING   the handler finishes every plot and exits;
+ *   BUSY -> PENDING   the handler defers: the operation, on ending, sees
+ *                     PENDING and finishes the plots and exits itself;
+ *   CLOSING          an operation that finds it waits for the exit. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,6 +47,34 @@ struct sicm_plot {
 static sicm_plot *open_plots[kMaxOpenPlots];
 static int handlers_installed;
 
+enum { kIdle, kBusy, kClosing, kPending };
+static atomic_int plot_state = kIdle;
+static volatile sig_atomic_t pending_signal;
+
+static void finish_and_exit(int sig) {
+  sicm_plot_close_all();
+  _exit(128 + sig);
+}
+
+/* Enter a plot operation; if the plots are being closed, wait for the exit. */
+static void enter_operation(void) {
+  int expected = kIdle;
+  while (!atomic_compare_exchange_weak(&plot_state, &expected, kBusy)) {
+    if (expected == kClosing || expected == kPending)
+      for (;;)
+        pause();
+    expected = kIdle;
+  }
+}
+
+static void leave_operation(void) {
+  int expected = kBusy;
+  if (!atomic_compare_exchange_strong(&plot_state, &expected, kIdle)) {
+    atomic_store(&plot_state, kClosing); /* a signal came meanwhile: act on it */
+    finish_and_exit(pending_signal);
+  }
+}
+
 static void remember(sicm_plot *p) {
   for (int i = 0; i < kMaxOpenPlots; ++i)
     if (!open_plots[i]) {
@@ -51,11 +89,16 @@ static void forget(sicm_plot *p) {
 }
 
 static void on_signal(int sig) {
-  /* Finishing the files here is not strictly async-signal-safe (stdio), but
-   * the alternative, losing the picture of an hours-long run, is worse; the
-   * process exits right after. */
-  sicm_plot_close_all();
-  _exit(128 + sig);
+  /* Finishing the files uses stdio, which is not formally async-signal-safe;
+   * the state word guarantees no plot operation is half done, and losing
+   * the picture of an hours-long run would be worse. */
+  pending_signal = sig;
+  int expected = kIdle;
+  if (atomic_compare_exchange_strong(&plot_state, &expected, kClosing)) finish_and_exit(sig);
+  expected = kBusy;
+  if (atomic_compare_exchange_strong(&plot_state, &expected, kPending)) return;
+  for (;;)
+    pause(); /* closing already: the exit is on its way */
 }
 
 static void on_exit_finish(void) {
@@ -115,7 +158,9 @@ sicm_plot *sicm_plot_open(const char *dir, const char *name, const char *title, 
   fprintf(p->tsv, "# %s\n# x\ty\n", p->title);
   fflush(p->tsv);
   install_handlers();
+  enter_operation();
   remember(p);
+  leave_operation();
   return p;
 }
 
@@ -135,6 +180,9 @@ static int add_mark(sicm_plot *p, mark m) {
   return 0;
 }
 
+static int add_point(sicm_plot *p, double x, double y);
+static int add_line(sicm_plot *p, double x0, double y0, double x1, double y1);
+
 static void write_tsv_number(FILE *f, double x) {
   char buf[SICM_DOUBLE_BUFSIZE];
   /* The TSV holds plain C numbers (0.5, not MIT's .5) so any tool reads it. */
@@ -150,6 +198,13 @@ static void after_write(sicm_plot *p) {
 }
 
 int sicm_plot_point(sicm_plot *p, double x, double y) {
+  enter_operation();
+  int status = add_point(p, x, y);
+  leave_operation();
+  return status;
+}
+
+static int add_point(sicm_plot *p, double x, double y) {
   mark m = {x, y, NAN, NAN};
   if (add_mark(p, m) != 0) return -1;
   write_tsv_number(p->tsv, x);
@@ -161,6 +216,13 @@ int sicm_plot_point(sicm_plot *p, double x, double y) {
 }
 
 int sicm_plot_line(sicm_plot *p, double x0, double y0, double x1, double y1) {
+  enter_operation();
+  int status = add_line(p, x0, y0, x1, y1);
+  leave_operation();
+  return status;
+}
+
+static int add_line(sicm_plot *p, double x0, double y0, double x1, double y1) {
   mark m = {x0, y0, x1, y1};
   if (add_mark(p, m) != 0) return -1;
   write_tsv_number(p->tsv, x0);
@@ -287,7 +349,7 @@ static int write_svg(const sicm_plot *p) {
   return 0;
 }
 
-int sicm_plot_finish(sicm_plot *p) {
+static int finish_plot(sicm_plot *p) {
   if (p->closed) return 0;
   p->closed = 1;
   int status = 0;
@@ -297,19 +359,29 @@ int sicm_plot_finish(sicm_plot *p) {
   return status;
 }
 
+int sicm_plot_finish(sicm_plot *p) {
+  enter_operation();
+  int status = finish_plot(p);
+  leave_operation();
+  return status;
+}
+
 void sicm_plot_free(sicm_plot *p) {
   if (!p) return;
-  sicm_plot_finish(p);
+  enter_operation();
+  finish_plot(p);
   forget(p);
+  leave_operation();
   free(p->marks);
   free(p->path);
   free(p->title);
   free(p);
 }
 
+/* Called by the exit and signal paths, which own the plots by then. */
 void sicm_plot_close_all(void) {
   for (int i = 0; i < kMaxOpenPlots; ++i)
-    if (open_plots[i]) sicm_plot_finish(open_plots[i]);
+    if (open_plots[i]) finish_plot(open_plots[i]);
 }
 
 size_t sicm_plot_count(const sicm_plot *p) {

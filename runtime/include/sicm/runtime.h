@@ -8,6 +8,14 @@
 
 #include <stddef.h>
 
+/* Numerical modules, one header each (documented there): status codes and
+ * the error hook, ODE integrators, minimizers, root finders, quadrature. */
+#include "sicm/error.h"
+#include "sicm/min.h"
+#include "sicm/ode.h"
+#include "sicm/quad.h"
+#include "sicm/root.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif

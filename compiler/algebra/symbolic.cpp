@@ -1,0 +1,296 @@
+// The bridge between Scheme values and the expression algebra, and the algebra's primitives.
+#include "algebra/symbolic.hpp"
+
+#include <cmath>
+
+#include "algebra/expr.hpp"
+#include "algebra/simplify.hpp"
+#include "algebra/structure.hpp"
+#include "eval/core.hpp"
+#include "eval/number.hpp"
+#include "eval/primitive.hpp"
+#include "print/printer.hpp"
+
+namespace sicm {
+
+namespace {
+
+constexpr OpInfo kOpInfo[] = {
+#define SICM_OP(name, scheme, arity, c) {scheme, arity, c},
+#include "algebra/ops.def"
+#undef SICM_OP
+};
+
+// An expression id as a Value: numbers and symbols as themselves, anything
+// else as Tag::Expr.
+Value expr_value(ExprId id) {
+  const ExprNode &n = expr_node(id);
+  switch (n.kind) {
+  case ExprKind::Rational:
+  case ExprKind::Flonum: return expr_number_value(id);
+  case ExprKind::Symbol: return Value::object(Tag::Symbol, n.sym);
+  case ExprKind::Apply:
+  case ExprKind::Call: break;
+  }
+  Value v;
+  v.tag = Tag::Expr;
+  v.i = id;
+  return v;
+}
+
+Value datum_to_value(Value d, const char *who);
+
+// A Value usable inside an expression as a node: a number, a symbol, an
+// expression, an up/down structure (a Call of up or down), a list datum.
+ExprId value_to_expr(Value v, int argpos, const char *who) {
+  switch (v.tag) {
+  case Tag::Expr: return static_cast<ExprId>(v.i);
+  case Tag::Symbol: return expr_symbol(v.symbol());
+  case Tag::Structure: {
+    Structure *s = as_structure(v);
+    std::vector<ExprId> items;
+    for (size_t i = 0; i < s->len; i++)
+      items.push_back(value_to_expr(s->items[i], argpos, who));
+    ExprId head = expr_symbol(intern(s->up ? "up" : "down").symbol());
+    return expr_call(head, items.data(), items.size());
+  }
+  case Tag::Pair: return value_to_expr(datum_to_value(v, who), argpos, who);
+  default:
+    if (is_number(v)) return expr_from_number(v);
+    wrong_type(v, argpos, who);
+  }
+}
+
+// ---- construction with light rewrites ----------------------------------------------
+
+bool exact_zero(Value v) {
+  return is_exact(v) && num_is_zero(v);
+}
+
+bool exact_one(Value v) {
+  return v.is(Tag::Fixnum) && v.i == 1;
+}
+
+// Sum of numbers and expressions: numbers folded into one last term, exact
+// zeros dropped.
+Value build_sum(const Value *args, int n, const char *who) {
+  std::vector<ExprId> terms;
+  Value constant = Value::fixnum(0);
+  for (int i = 0; i < n; i++) {
+    if (is_number(args[i]))
+      constant = num_add(constant, args[i]);
+    else
+      terms.push_back(value_to_expr(args[i], i + 1, who));
+  }
+  if (terms.empty()) return constant;
+  if (!exact_zero(constant)) terms.push_back(expr_from_number(constant));
+  if (terms.size() == 1) return expr_value(terms[0]);
+  return expr_value(expr_apply(Op::Add, terms.data(), terms.size()));
+}
+
+// Product: numbers folded into one first factor, exact ones dropped, an exact
+// zero factor makes the product 0.
+Value build_product(const Value *args, int n, const char *who) {
+  std::vector<ExprId> factors;
+  Value coefficient = Value::fixnum(1);
+  for (int i = 0; i < n; i++) {
+    if (is_number(args[i]))
+      coefficient = num_mul(coefficient, args[i]);
+    else
+      factors.push_back(value_to_expr(args[i], i + 1, who));
+  }
+  if (exact_zero(coefficient) || factors.empty()) return coefficient;
+  if (!exact_one(coefficient)) factors.insert(factors.begin(), expr_from_number(coefficient));
+  if (factors.size() == 1) return expr_value(factors[0]);
+  return expr_value(expr_apply(Op::Mul, factors.data(), factors.size()));
+}
+
+Value build_power(Value base, Value exponent) {
+  if (exact_zero(exponent)) return Value::fixnum(1);
+  if (exact_one(exponent)) return base;
+  if (exact_one(base)) return base;
+  ExprId b = value_to_expr(base, 1, "expt");
+  ExprId e = value_to_expr(exponent, 2, "expt");
+  return expr_value(expr_apply(Op::Expt, {b, e}));
+}
+
+// The reciprocal of a value: a number's (division by an exact zero is
+// MIT's error), otherwise (expt x -1).
+Value reciprocal(Value v) {
+  if (is_number(v)) return num_div(Value::fixnum(1), v);
+  return build_power(v, Value::fixnum(-1));
+}
+
+Value fold_unary(Op op, Value x) {
+  switch (op) {
+  case Op::Sqrt: return num_sqrt(x);
+  case Op::Exp: return num_exp(x);
+  case Op::Log: return num_log(x);
+  case Op::Sin: return num_sin(x);
+  case Op::Cos: return num_cos(x);
+  case Op::Tan: return num_tan(x);
+  case Op::Asin: return num_asin(x);
+  case Op::Acos: return num_acos(x);
+  case Op::Atan: return num_atan(x);
+  case Op::Abs: return num_abs(x);
+  case Op::Sinh: return exact_zero(x) ? Value::fixnum(0) : Value::flonum(std::sinh(to_double(x)));
+  case Op::Cosh: return exact_zero(x) ? Value::fixnum(1) : Value::flonum(std::cosh(to_double(x)));
+  default: SICM_ASSERT(false);
+  }
+  return x;
+}
+
+} // namespace
+
+const OpInfo &op_info(Op op) {
+  return kOpInfo[static_cast<size_t>(op)];
+}
+
+Value symbolic_apply(Op op, const Value *args, int nargs) {
+  const char *who = op_info(op).scheme_name;
+  int arity = op_info(op).arity;
+  bool n_ary = op == Op::Add || op == Op::Mul || op == Op::Sub || op == Op::Div;
+  SICM_ASSERT(n_ary ? nargs >= (op == Op::Sub || op == Op::Div)
+                    : nargs == arity || (op == Op::Atan && (nargs == 1 || nargs == 2)));
+  switch (op) {
+  case Op::Add: return build_sum(args, nargs, who);
+  case Op::Mul: return build_product(args, nargs, who);
+  case Op::Sub: {
+    if (nargs == 1) {
+      Value v[2] = {Value::fixnum(-1), args[0]};
+      return build_product(v, 2, who);
+    }
+    gcvec<Value> terms{args[0]};
+    for (int i = 1; i < nargs; i++) {
+      Value v[2] = {Value::fixnum(-1), args[i]};
+      terms.push_back(build_product(v, 2, who));
+    }
+    return build_sum(terms.data(), static_cast<int>(terms.size()), who);
+  }
+  case Op::Div: {
+    if (nargs == 1) return reciprocal(args[0]);
+    gcvec<Value> factors{args[0]};
+    for (int i = 1; i < nargs; i++)
+      factors.push_back(reciprocal(args[i]));
+    return build_product(factors.data(), static_cast<int>(factors.size()), who);
+  }
+  case Op::Expt:
+    if (is_number(args[0]) && is_number(args[1])) return num_expt(args[0], args[1]);
+    return build_power(args[0], args[1]);
+  default: break;
+  }
+  bool numbers = true;
+  for (int i = 0; i < nargs; i++)
+    numbers = numbers && is_number(args[i]);
+  if (numbers) return nargs == 2 ? num_atan2(args[0], args[1]) : fold_unary(op, args[0]);
+  ExprId ids[2];
+  for (int i = 0; i < nargs; i++)
+    ids[i] = value_to_expr(args[i], i + 1, who);
+  return expr_value(expr_apply(op, ids, static_cast<size_t>(nargs)));
+}
+
+Value symbolic_call(Value head, const Value *args, int nargs) {
+  ExprId h = value_to_expr(head, 1, "apply");
+  std::vector<ExprId> ids;
+  for (int i = 0; i < nargs; i++)
+    ids.push_back(value_to_expr(args[i], i + 2, "apply"));
+  return expr_value(expr_call(h, ids.data(), ids.size()));
+}
+
+namespace {
+
+// A prefix-form datum as a value: (op args...) for operators of ops.def with a
+// fitting number of arguments (built as by arithmetic), any other list as a
+// function applied to arguments, (up ...) and (down ...) included.
+Value datum_to_value(Value d, const char *who) {
+  if (!is_pair(d)) {
+    if (is_number(d) || is_symbol(d) || d.is(Tag::Expr)) return d;
+    wrong_type(d, 1, who);
+  }
+  long len = list_length(d);
+  if (len < 1) wrong_type(d, 1, who);
+  gcvec<Value> args;
+  for (Value p = cdr(d); is_pair(p); p = cdr(p))
+    args.push_back(datum_to_value(car(p), who));
+  int n = static_cast<int>(args.size());
+  Value head = car(d);
+  if (is_symbol(head)) {
+    for (size_t i = 0; i < std::size(kOpInfo); i++) {
+      Op op = static_cast<Op>(i);
+      if (symbol_name(head) != kOpInfo[i].scheme_name) continue;
+      int arity = kOpInfo[i].arity;
+      bool fits = op == Op::Atan ? n == 1 || n == 2 : arity < 0 ? n >= 1 : n == arity;
+      if (fits) return symbolic_apply(op, args.data(), n);
+    }
+  }
+  return symbolic_call(datum_to_value(head, who), args.data(), n);
+}
+
+} // namespace
+
+Value datum_to_expression(Value datum) {
+  return datum_to_value(datum, "datum->expression");
+}
+
+Value simplify_value(Value v) {
+  switch (v.tag) {
+  case Tag::Expr: return expr_value(simplify_expr(static_cast<ExprId>(v.i)));
+  case Tag::Pair: {
+    if (list_length(v) < 0) return v;
+    gcvec<Value> items;
+    for (Value p = v; is_pair(p); p = cdr(p))
+      items.push_back(simplify_value(car(p)));
+    return list_from(items.data(), items.size());
+  }
+  default: return v;
+  }
+}
+
+Value expression_to_datum(Value v) {
+  switch (v.tag) {
+  case Tag::Expr: return expr_to_datum(simplify_expr(static_cast<ExprId>(v.i)));
+  case Tag::Pair: {
+    if (list_length(v) < 0) return v;
+    gcvec<Value> items;
+    for (Value p = v; is_pair(p); p = cdr(p))
+      items.push_back(expression_to_datum(car(p)));
+    return list_from(items.data(), items.size());
+  }
+  default: return v;
+  }
+}
+
+// ---- primitives ---------------------------------------------------------------------
+
+namespace {
+
+Value P_simplify(Value *a, int) {
+  return simplify_value(a[0]);
+}
+
+Value P_print_expression(Value *a, int) {
+  output(write_string(simplify_value(a[0])));
+  output("\n");
+  return Value::unspecified();
+}
+
+Value P_expression(Value *a, int) {
+  return expression_to_datum(a[0]);
+}
+
+Value P_datum_to_expression(Value *a, int) {
+  return datum_to_expression(a[0]);
+}
+
+} // namespace
+
+void install_algebra_primitives() {
+  define_primitive("simplify", 1, 1, P_simplify);
+  define_primitive("print-expression", 1, 1, P_print_expression);
+  define_primitive("pe", 1, 1, P_print_expression);
+  define_primitive("expression", 1, 1, P_expression);
+  define_primitive("datum->expression", 1, 1, P_datum_to_expression);
+  set_datum_converter(Tag::Expr, expression_to_datum);
+}
+
+} // namespace sicm

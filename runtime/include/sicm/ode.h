@@ -1,0 +1,226 @@
+/* sicm runtime: ODE integrators (adaptive steppers and fixed-step symplectic maps). */
+#ifndef SICM_ODE_H
+#define SICM_ODE_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- the system ---------------------------------------------------------
+ * A system of first-order equations dy/dt = f(t, y) of dimension dim.
+ *
+ * sicm_ode_rhs stores f(t, y) in dydt[0..dim-1] and returns 0. Any other
+ * return value stops the integration at once: sicm_ode_evolve then returns
+ * SICM_EUSER and leaves t and y at the last accepted step. The integrator
+ * checks the values it receives: a non-finite derivative makes it retry with
+ * a smaller step, and if no step size helps it fails with SICM_ESTEP or
+ * SICM_EBADFUNC.
+ *
+ * sicm_ode_jacobian stores the Jacobian of f in dfdy, row-major
+ * (dfdy[i*dim + j] = df_i/dy_j), and df/dt in dfdt[0..dim-1]; both arrays
+ * are always supplied. Its return value means what sicm_ode_rhs's does. */
+typedef int (*sicm_ode_rhs)(double t, const double *y, double *dydt, void *params);
+typedef int (*sicm_ode_jacobian)(double t, const double *y, double *dfdy, double *dfdt,
+                                 void *params);
+
+/* ---- step types -----------------------------------------------------------
+ * The algorithm is chosen by a constant type, as in GSL:
+ *
+ *   sicm_ode_step_rk8pd        Dormand-Prince 8(7), GSL. Explicit, high order;
+ *                              the best general choice for smooth non-stiff
+ *                              problems at tight tolerances.
+ *   sicm_ode_step_rkf45        Runge-Kutta-Fehlberg 4(5), GSL.
+ *   sicm_ode_step_rkck         Cash-Karp 4(5), GSL.
+ *   sicm_ode_step_msbdf        Variable-order (1-5) BDF, GSL, for stiff problems;
+ *                              uses the Jacobian (finite differences if none is set).
+ *   sicm_ode_step_bs           Bulirsch-Stoer: Gragg's modified midpoint rule with
+ *                              polynomial extrapolation, adaptive order and step
+ *                              (Deuflhard; Hairer-Norsett-Wanner). The default of
+ *                              scmutils and SICM; very efficient at tight
+ *                              tolerances on smooth non-stiff problems.
+ *   sicm_ode_step_cvode_adams  SUNDIALS CVODE, variable-order (1-12) Adams-Moulton
+ *                              with fixed-point iteration; non-stiff.
+ *   sicm_ode_step_cvode_bdf    SUNDIALS CVODE, variable-order (1-5) BDF with Newton
+ *                              iteration and a dense linear solver; stiff. Uses the
+ *                              Jacobian if set, difference quotients otherwise. */
+typedef struct sicm_ode_step_type sicm_ode_step_type;
+
+extern const sicm_ode_step_type *const sicm_ode_step_rk8pd;
+extern const sicm_ode_step_type *const sicm_ode_step_rkf45;
+extern const sicm_ode_step_type *const sicm_ode_step_rkck;
+extern const sicm_ode_step_type *const sicm_ode_step_msbdf;
+extern const sicm_ode_step_type *const sicm_ode_step_bs;
+extern const sicm_ode_step_type *const sicm_ode_step_cvode_adams;
+extern const sicm_ode_step_type *const sicm_ode_step_cvode_bdf;
+
+/* sicm_ode_step_type_name returns the type's short name ("rk8pd", "bs",
+ * "cvode-bdf", ...), as used in messages. */
+const char *sicm_ode_step_type_name(const sicm_ode_step_type *T);
+
+/* ---- the integrator -------------------------------------------------------
+ * An integrator object holds the system, the tolerances, the algorithm's
+ * state (step size, order, multistep history) and statistics. It is not
+ * tied to a time or state: each call of sicm_ode_evolve says where to start.
+ *
+ * Tolerances. A step is accepted when the estimate e_i of its local error
+ * satisfies, for every component i,
+ *
+ *     |e_i| <= abs_tol + rel_tol * |y_i|
+ *
+ * where y_i is the component at the end of the step. This is the test of
+ * Bulirsch-Stoer and of the GSL Runge-Kutta steppers (GSL's controller lets
+ * the largest ratio reach 1.1 before rejecting). The multistep methods
+ * (msbdf, CVODE) apply the same weights to the root-mean-square over the
+ * components of e_i / (abs_tol + rel_tol |y_i|), which is at most the
+ * maximum, so their test is slightly looser, and their error estimates are
+ * less conservative: at equal tolerances their global errors are typically
+ * 10 to 100 times those of the one-step methods. The tolerances bound the
+ * error committed in one step, not the global error, which accumulates over
+ * the steps (and can grow exponentially for unstable or chaotic systems).
+ *
+ * scmutils' `evolve` and `state-advancer` take a single "local error"
+ * number: the interpreter passes it as both abs_tol and rel_tol.
+ *
+ * All functions that return int return SICM_SUCCESS (0) or one of the codes of
+ * sicm/error.h; every failure is also reported through the error hook. */
+typedef struct sicm_ode sicm_ode;
+
+/* Statistics accumulated over the object's lifetime (sicm_ode_reset does not
+ * clear them). steps counts accepted steps; rejected_steps counts step
+ * attempts that were discarded and retried with a smaller step (error test
+ * failures, non-finite values, and for CVODE nonlinear convergence failures);
+ * rhs_evals counts every call of the right-hand side, including those made
+ * to estimate Jacobians by finite differences and to choose the first step;
+ * jacobian_evals counts Jacobian evaluations, analytic or by differences. */
+typedef struct {
+  unsigned long steps;
+  unsigned long rejected_steps;
+  unsigned long rhs_evals;
+  unsigned long jacobian_evals;
+} sicm_ode_stats;
+
+/* sicm_ode_alloc creates an integrator of type T for a system of dimension
+ * dim >= 1 with right-hand side f, whose last argument will be params.
+ * abs_tol and rel_tol must be non-negative and not both zero. Returns NULL
+ * (and reports through the error hook) for invalid arguments or when memory
+ * runs out. */
+sicm_ode *sicm_ode_alloc(const sicm_ode_step_type *T, size_t dim, sicm_ode_rhs f, void *params,
+                         double abs_tol, double rel_tol);
+
+/* sicm_ode_free releases o and everything it owns; NULL is allowed. */
+void sicm_ode_free(sicm_ode *o);
+
+/* sicm_ode_set_jacobian gives the integrator an analytic Jacobian (NULL
+ * goes back to finite differences). Only the implicit methods, msbdf and
+ * cvode-bdf, use it; for the others it is accepted and ignored. It takes
+ * effect at the next sicm_ode_evolve, which restarts the method. Returns
+ * SICM_SUCCESS. */
+int sicm_ode_set_jacobian(sicm_ode *o, sicm_ode_jacobian jac);
+
+/* sicm_ode_set_max_steps limits the number of steps one call of
+ * sicm_ode_evolve may take (default 500000); exceeding it fails with
+ * SICM_EMAXITER. max_steps must be positive. */
+int sicm_ode_set_max_steps(sicm_ode *o, unsigned long max_steps);
+
+/* sicm_ode_evolve advances the solution from (*t, y) to exactly t1 with
+ * adaptive steps (t1 may lie before *t: integration runs backwards), and on
+ * success sets *t = t1 and y to the solution there.
+ *
+ * The step size, order and multistep history are kept between calls, so a
+ * loop that calls sicm_ode_evolve repeatedly in small increments of t (a
+ * monitor printing or plotting the state) costs little more than one long
+ * call: steps are shortened only to land on each t1, and the next call
+ * resumes with the step size the error control had reached. If the caller
+ * changes *t or y between calls (for instance restarts from a new initial
+ * condition), the object notices and restarts its method from scratch; see
+ * also sicm_ode_reset.
+ *
+ * On failure the return value is non-zero, *t and y hold the last point
+ * reached (the last accepted step), and sicm_ode_last_error(o) describes
+ * the failure, naming the method, the time, the state vector and the reason
+ * (step size too small, non-finite state or derivative, too many steps,
+ * stopped by the right-hand side), e.g.
+ *
+ *   rk8pd: step size too small at t = 1.00000000000716 with state [1101882664230043.6]:
+ *   the error test fails even for the shortest step the resolution of t allows
+ *   (h = 1.03e-16); the solution may be singular here
+ *
+ * (times and components are printed as the compiler prints numbers; at most
+ * 16 components are shown).
+ *
+ * The same message goes to the error hook. */
+int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y);
+
+/* sicm_ode_reset makes the next sicm_ode_evolve start afresh: the step size is
+ * chosen again and multistep history is discarded. Statistics are kept. */
+void sicm_ode_reset(sicm_ode *o);
+
+/* sicm_ode_get_stats returns the object's statistics; the pointer stays
+ * valid until sicm_ode_free and its contents change with each evolve. */
+const sicm_ode_stats *sicm_ode_get_stats(const sicm_ode *o);
+
+/* sicm_ode_last_error returns the message of the last failed
+ * sicm_ode_evolve, or "" if none has failed. The string is owned by o and
+ * overwritten by the next failure. */
+const char *sicm_ode_last_error(const sicm_ode *o);
+
+/* sicm_ode_name returns the name of o's step type. */
+const char *sicm_ode_name(const sicm_ode *o);
+
+/* ---- symplectic integrators for separable Hamiltonians -------------------
+ * For H(t, q, p) = T(p) + V(t, q) with ndof degrees of freedom, these
+ * fixed-step methods are symplectic, time-reversible, and conserve the energy
+ * of autonomous systems up to a bounded oscillation (no secular drift) over
+ * very long times, which adaptive methods do not.
+ *
+ * sicm_force stores dV/dq at (t, q) in dVdq[0..ndof-1]; sicm_velocity stores
+ * dT/dp at p in dTdp[0..ndof-1] (T must not depend on t or q). Both return 0,
+ * or non-zero to stop the integration (SICM_EUSER).
+ *
+ * The methods are compositions of the Stormer-Verlet ("leapfrog",
+ * kick-drift-kick) map S(h):
+ *
+ *   sicm_symplectic_verlet    S(h), order 2; one force evaluation per step.
+ *   sicm_symplectic_yoshida4  S(w1 h) S(w0 h) S(w1 h) with Yoshida's triple-jump
+ *                             weights w1 = 1/(2 - 2^(1/3)), w0 = 1 - 2 w1;
+ *                             order 4; 3 force evaluations per step.
+ *   sicm_symplectic_yoshida6  Yoshida (1990) solution A, 7 stages; order 6.
+ *   sicm_symplectic_yoshida8  Yoshida (1990) solution A, 15 stages; order 8.
+ *
+ * Time dependence of V is handled exactly in the sense of the extended phase
+ * space: t advances with the drifts, so the orders above hold for V(t, q)
+ * too. */
+typedef int (*sicm_force)(double t, const double *q, double *dVdq, void *params);
+typedef int (*sicm_velocity)(const double *p, double *dTdp, void *params);
+
+typedef struct sicm_symplectic_type sicm_symplectic_type;
+
+extern const sicm_symplectic_type *const sicm_symplectic_verlet;
+extern const sicm_symplectic_type *const sicm_symplectic_yoshida4;
+extern const sicm_symplectic_type *const sicm_symplectic_yoshida6;
+extern const sicm_symplectic_type *const sicm_symplectic_yoshida8;
+
+/* sicm_symplectic_name returns "verlet", "yoshida4", "yoshida6" or "yoshida8";
+ * sicm_symplectic_order returns the method's order of accuracy. */
+const char *sicm_symplectic_name(const sicm_symplectic_type *T);
+int sicm_symplectic_order(const sicm_symplectic_type *T);
+
+/* sicm_symplectic_evolve advances (q, p) from *t to exactly t1 with n equal
+ * steps, n the smallest number of steps of size at most |h| that covers
+ * |t1 - *t| (so the step is exactly h when h divides the interval; the sign of
+ * h is ignored, the direction is that of t1 - *t). On success *t = t1. On
+ * failure (a callback returned non-zero, or q or p became non-finite) it
+ * returns non-zero, leaves *t, q and p at the last completed step, and
+ * reports a message naming the time and the state through the error hook.
+ * h must be finite and non-zero. */
+int sicm_symplectic_evolve(const sicm_symplectic_type *T, size_t ndof, sicm_force dVdq,
+                           sicm_velocity dTdp, void *params, double *t, double t1, double h,
+                           double *q, double *p);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SICM_ODE_H */

@@ -1,0 +1,96 @@
+/* Private to the ODE module: the integrator object, step-type table and shared helpers. */
+#ifndef SICM_ODE_INTERNAL_H
+#define SICM_ODE_INTERNAL_H
+
+#include <stddef.h>
+
+#include "sicm/runtime.h"
+
+/* A step type is a small table of functions (a "backend"). ode.c implements
+ * the GSL steppers, ode_bs.c Bulirsch-Stoer, ode_cvode.c CVODE. The driver
+ * in ode.c validates arguments, notices when the caller has moved the
+ * state between calls, and keeps statistics of rhs calls; the backend does
+ * the stepping.
+ *
+ *   init    allocate the backend's state into o->backend (o->dim etc. are set).
+ *   evolve  advance (*t, y) to t1, which differs from *t. On failure leave the
+ *           last accepted point in (*t, y) and return the status from
+ *           sicm_ode_fail, which has already composed the message.
+ *   reset   forget step size and history (o->h is cleared by the driver).
+ *   free    release o->backend. */
+struct sicm_ode_step_type {
+  const char *name;
+  int (*init)(sicm_ode *o);
+  int (*evolve)(sicm_ode *o, double *t, double t1, double *y);
+  void (*reset)(sicm_ode *o);
+  void (*free)(sicm_ode *o);
+  const void *data; /* backend-specific: the GSL step type, the CVODE method */
+};
+
+enum { SICM_ODE_MESSAGE_SIZE = 1024 };
+
+struct sicm_ode {
+  const sicm_ode_step_type *type;
+  size_t dim;
+  sicm_ode_rhs f;
+  sicm_ode_jacobian jac; /* NULL: finite differences */
+  void *params;
+  double abs_tol, rel_tol;
+  unsigned long max_steps; /* per evolve call */
+
+  /* Step size to try next, signed; 0 means "choose one". Kept between calls
+   * so that short successive evolves resume at the controller's step. */
+  double h;
+
+  /* The point the last successful evolve ended at, to notice a caller who
+   * moves the state between calls (then the method restarts). */
+  int have_last;
+  double t_last;
+  double *y_last;
+
+  int user_status; /* what the rhs or Jacobian returned when it stopped us */
+  sicm_ode_stats stats;
+  char message[SICM_ODE_MESSAGE_SIZE];
+  void *backend;
+};
+
+/* Results of sicm_ode_call_rhs and sicm_ode_call_jacobian, besides
+ * SICM_SUCCESS: SICM_EUSER (the user function returned non-zero; its value
+ * is in o->user_status) or SICM_EBADFUNC (non-finite argument or result;
+ * the caller should retry with a smaller step). */
+int sicm_ode_call_rhs(sicm_ode *o, double t, const double *y, double *dydt);
+int sicm_ode_call_jacobian(sicm_ode *o, double t, const double *y, double *dfdy, double *dfdt,
+                           double *work);
+
+/* sicm_ode_initial_step proposes a first step for a method of the given
+ * order from (t, y) with derivative f0 towards t1, by the estimate of
+ * Hairer, Norsett and Wanner (I, II.4): make the first step's error estimate
+ * about the tolerance judging from the sizes of y, f and f'. Uses one rhs
+ * evaluation (work needs 2*dim doubles). Returns the signed step, or 0 with
+ * *status set if the rhs failed. */
+double sicm_ode_initial_step(sicm_ode *o, double t, const double *y, const double *f0, double t1,
+                             int order, double *work, int *status);
+
+/* sicm_ode_error_norm returns max_i |err_i| / (abs_tol + rel_tol |y_i|):
+ * the step is acceptable when it is at most 1. */
+double sicm_ode_error_norm(const sicm_ode *o, const double *err, const double *y);
+
+/* sicm_ode_fail composes o->message as "NAME: WHAT at t = T with state
+ * [y...]: DETAIL", reports it through the error hook, and returns status.
+ * detail may be NULL. */
+int sicm_ode_fail(sicm_ode *o, int status, double t, const double *y, const char *what,
+                  const char *detail);
+
+/* The messages of the usual failures, shared so all backends say the same. */
+int sicm_ode_fail_user(sicm_ode *o, double t, const double *y);
+int sicm_ode_fail_max_steps(sicm_ode *o, double t, const double *y);
+
+/* All components finite? */
+int sicm_ode_finite(size_t n, const double *v);
+
+/* The backends' type tables. */
+extern const sicm_ode_step_type sicm_ode_bs_type;
+extern const sicm_ode_step_type sicm_ode_cvode_adams_type;
+extern const sicm_ode_step_type sicm_ode_cvode_bdf_type;
+
+#endif /* SICM_ODE_INTERNAL_H */

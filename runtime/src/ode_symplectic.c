@@ -1,0 +1,222 @@
+/* Symplectic fixed-step integrators for separable Hamiltonians: Verlet and Yoshida compositions.
+ *
+ * Every method is a symmetric composition S(w_1 h) S(w_2 h) ... S(w_s h) of
+ * the kick-drift-kick leapfrog S(h): p -= h/2 V_q; q += h T_p; p -= h/2 V_q.
+ * Consecutive half kicks at the same (t, q) are merged, so a step of an
+ * s-stage method costs s force evaluations (plus one at the very start of a
+ * call). Since each stage is the exact flow of T or of V, the composition is
+ * symplectic; being symmetric, its order is even.
+ *
+ * The weights: Yoshida, "Construction of higher order symplectic
+ * integrators", Phys. Lett. A 150 (1990) 262. Order 4 is the triple jump
+ * w1 = 1/(2 - 2^(1/3)), w0 = 1 - 2 w1, computed here from the closed form.
+ * Orders 6 and 8 use his "solution A" weights w_1..w_m, printed with 15
+ * significant digits, and w_0 = 1 - 2 (w_1 + ... + w_m) so that the weights
+ * sum to 1 exactly; the sequence is w_m ... w_1 w_0 w_1 ... w_m. The printed
+ * digits satisfy the order conditions to about 1e-15, which shows only far
+ * below any useful step size. The orders are verified by a convergence test
+ * (tests/unit/ode_test.cpp), not taken on trust. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sicm/runtime.h"
+
+enum { kMaxStages = 15, kMaxStateShown = 8 };
+
+struct sicm_symplectic_type {
+  const char *name;
+  int order;
+  int stages;
+  int half;            /* orders 6, 8: number of published weights w_1..w_half */
+  double published[7]; /* w_1..w_half; w_0 is derived */
+};
+
+/* The full symmetric weight sequence of T, into w[0..T->stages-1]. */
+static void weights(const sicm_symplectic_type *T, double *w) {
+  if (T->stages == 1) {
+    w[0] = 1.0;
+    return;
+  }
+  if (T->order == 4) {
+    const double c = cbrt(2.0), w1 = 1.0 / (2.0 - c);
+    w[0] = w[2] = w1;
+    w[1] = 1.0 - 2.0 * w1; /* = -c / (2 - c) */
+    return;
+  }
+  const int m = T->half;
+  double sum = 0;
+  for (int i = 0; i < m; i++)
+    sum += T->published[i];
+  /* published[i] is w_{i+1}; the sequence is w_m .. w_1 w_0 w_1 .. w_m */
+  w[m] = 1.0 - 2.0 * sum;
+  for (int i = 0; i < m; i++)
+    w[m - 1 - i] = w[m + 1 + i] = T->published[i];
+}
+
+static const sicm_symplectic_type verlet = {"verlet", 2, 1, 0, {0}};
+static const sicm_symplectic_type yoshida4 = {"yoshida4", 4, 3, 0, {0}};
+static const sicm_symplectic_type yoshida6 = {
+    "yoshida6", 6, 7, 3, {-1.17767998417887, 0.235573213359357, 0.784513610477560}};
+static const sicm_symplectic_type yoshida8 = {
+    "yoshida8",
+    8,
+    15,
+    7,
+    {-1.61582374150097, -2.44699182370524, -0.716989419708120e-2, 2.44002732616735,
+     0.157739928123617, 1.82020630970714, 1.04242620869991}};
+
+const sicm_symplectic_type *const sicm_symplectic_verlet = &verlet;
+const sicm_symplectic_type *const sicm_symplectic_yoshida4 = &yoshida4;
+const sicm_symplectic_type *const sicm_symplectic_yoshida6 = &yoshida6;
+const sicm_symplectic_type *const sicm_symplectic_yoshida8 = &yoshida8;
+
+const char *sicm_symplectic_name(const sicm_symplectic_type *T) {
+  return T->name;
+}
+int sicm_symplectic_order(const sicm_symplectic_type *T) {
+  return T->order;
+}
+
+static int all_finite(size_t n, const double *v) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i])) return 0;
+  return 1;
+}
+
+static void append_vector(char *buf, size_t size, size_t n, const double *v) {
+  char num[SICM_DOUBLE_BUFSIZE];
+  size_t len = strlen(buf);
+  for (size_t i = 0; i < n && i < kMaxStateShown && len + 1 < size; i++) {
+    sicm_format_double(num, v[i]);
+    snprintf(buf + len, size - len, "%s%s", i == 0 ? "[" : ", ", num);
+    len = strlen(buf);
+  }
+  if (n > kMaxStateShown && len + 1 < size) snprintf(buf + len, size - len, ", ...");
+  len = strlen(buf);
+  if (len + 1 < size) snprintf(buf + len, size - len, "]");
+}
+
+/* Report "NAME: WHAT at t = T with state q = [..], p = [..]: DETAIL". */
+static int fail(const sicm_symplectic_type *T, int status, size_t ndof, double t, const double *q,
+                const double *p, const char *what, const char *detail) {
+  char msg[768], tb[SICM_DOUBLE_BUFSIZE];
+  sicm_format_double(tb, t);
+  snprintf(msg, sizeof msg, "%s: %s at t = %s with state q = ", T->name, what, tb);
+  append_vector(msg, sizeof msg, ndof, q);
+  size_t len = strlen(msg);
+  snprintf(msg + len, sizeof msg - len, ", p = ");
+  append_vector(msg, sizeof msg, ndof, p);
+  len = strlen(msg);
+  snprintf(msg + len, sizeof msg - len, ": %s", detail);
+  return sicm_error(status, "%s", msg);
+}
+
+/* One composed step of size dt from time t: q, p advance in place. On entry
+ * *pending is the coefficient (times dt) of a kick still owed at (t, q); on
+ * exit it is the coefficient owed at the end of the step. The first force
+ * evaluation also yields the proper state at t (the owed kick alone
+ * applied), which is stored in proper_p (q itself is proper) for error
+ * recovery; *have_proper says whether that happened. */
+static int step(const double *w, int stages, size_t ndof, sicm_force dVdq, sicm_velocity dTdp,
+                void *params, double t, double dt, double *q, double *p, double *force,
+                double *velocity, double *pending, double *proper_p, int *have_proper) {
+  double tau = t;
+  *have_proper = 0;
+  for (int s = 0; s < stages; s++) {
+    const double kick = (*pending + 0.5 * w[s]) * dt;
+    if (dVdq(tau, q, force, params)) return SICM_EUSER;
+    if (s == 0) {
+      for (size_t i = 0; i < ndof; i++)
+        proper_p[i] = p[i] - *pending * dt * force[i];
+      *have_proper = 1;
+    }
+    for (size_t i = 0; i < ndof; i++)
+      p[i] -= kick * force[i];
+    if (dTdp(p, velocity, params)) return SICM_EUSER;
+    for (size_t i = 0; i < ndof; i++)
+      q[i] += w[s] * dt * velocity[i];
+    tau += w[s] * dt;
+    *pending = 0.5 * w[s];
+  }
+  return SICM_SUCCESS;
+}
+
+int sicm_symplectic_evolve(const sicm_symplectic_type *T, size_t ndof, sicm_force dVdq,
+                           sicm_velocity dTdp, void *params, double *t, double t1, double h,
+                           double *q, double *p) {
+  if (!T || !dVdq || !dTdp || ndof == 0)
+    return sicm_error(SICM_EINVAL, "sicm_symplectic_evolve: missing method, callback or "
+                                   "degrees of freedom");
+  if (!isfinite(h) || h == 0 || !isfinite(*t) || !isfinite(t1))
+    return sicm_error(SICM_EINVAL,
+                      "sicm_symplectic_evolve (%s): step %g and times %g, %g must be finite "
+                      "and the step non-zero",
+                      T->name, h, *t, t1);
+  if (!all_finite(ndof, q) || !all_finite(ndof, p))
+    return fail(T, SICM_EINVAL, ndof, *t, q, p, "non-finite state",
+                "the initial state has NaN or infinite components");
+  if (*t == t1) return SICM_SUCCESS;
+
+  const double t0 = *t, span = t1 - t0;
+  /* The smallest step count with |dt| <= |h|, forgiving rounding in span/h
+   * so that h dividing the interval gives exactly span/h steps. */
+  double ratio = fabs(span / h), whole = round(ratio);
+  double count = fabs(ratio - whole) <= 1e-9 * ratio ? whole : ceil(ratio);
+  if (count < 1) count = 1;
+  if (count > 1e15)
+    return sicm_error(SICM_EINVAL, "sicm_symplectic_evolve (%s): %g steps of %g are too many",
+                      T->name, count, h);
+  const unsigned long long nsteps = (unsigned long long)count;
+  const double dt = span / count;
+
+  double w[kMaxStages];
+  weights(T, w);
+  /* force, velocity: scratch for the callbacks. good_q, good_p, good_t: the
+   * last proper state known, which the caller gets back if a step fails.
+   * start_q: q at the start of the current step. */
+  double *scratch = malloc(5 * ndof * sizeof *scratch);
+  if (!scratch)
+    return sicm_error(SICM_ENOMEM, "sicm_symplectic_evolve (%s): out of memory", T->name);
+  double *force = scratch, *velocity = force + ndof, *good_q = velocity + ndof;
+  double *good_p = good_q + ndof, *start_q = good_p + ndof;
+  memcpy(good_q, q, ndof * sizeof *q);
+  memcpy(good_p, p, ndof * sizeof *p);
+  double good_t = t0, pending = 0;
+  int status = SICM_SUCCESS;
+  for (unsigned long long i = 0; i < nsteps && status == SICM_SUCCESS; i++) {
+    const double tstart = t0 + (double)i * dt;
+    int have_proper = 0;
+    memcpy(start_q, q, ndof * sizeof *q);
+    status = step(w, T->stages, ndof, dVdq, dTdp, params, tstart, dt, q, p, force, velocity,
+                  &pending, good_p, &have_proper);
+    if (have_proper) { /* good_p was just set to the proper momentum at tstart */
+      memcpy(good_q, start_q, ndof * sizeof *q);
+      good_t = tstart;
+    }
+    if (status == SICM_SUCCESS && !(all_finite(ndof, q) && all_finite(ndof, p)))
+      status = SICM_EBADFUNC;
+  }
+  if (status == SICM_SUCCESS) { /* pay the last half kick at t1 */
+    if (dVdq(t1, q, force, params) == 0) {
+      for (size_t k = 0; k < ndof; k++)
+        p[k] -= pending * dt * force[k];
+      *t = t1;
+    } else {
+      status = SICM_EUSER;
+    }
+  }
+  if (status != SICM_SUCCESS) {
+    memcpy(q, good_q, ndof * sizeof *q);
+    memcpy(p, good_p, ndof * sizeof *p);
+    *t = good_t;
+    status = status == SICM_EUSER
+                 ? fail(T, status, ndof, good_t, q, p, "stopped by the system",
+                        "a force or velocity function returned non-zero")
+                 : fail(T, status, ndof, good_t, q, p, "non-finite state",
+                        "a step produced NaN or infinity (is the step too long for the force?)");
+  }
+  free(scratch);
+  return status;
+}

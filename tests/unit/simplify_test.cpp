@@ -1,0 +1,261 @@
+// Unit tests of the simplifier and the prefix printer (compiler/algebra/simplify.cpp,
+// prefix_form.cpp); expected forms are scmutils'.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <chrono>
+#include <initializer_list>
+#include <string>
+
+#include "algebra/expr.hpp"
+#include "algebra/simplify.hpp"
+#include "algebra/symbolic.hpp"
+#include "eval/number.hpp"
+#include "print/printer.hpp"
+#include "syntax/error.hpp"
+#include "syntax/reader.hpp"
+#include "syntax/srcloc.hpp"
+
+namespace sicm {
+namespace {
+
+Value S(const char *name) {
+  return intern(name);
+}
+Value N(int64_t n) {
+  return Value::fixnum(n);
+}
+Value Q(int64_t p, int64_t q) {
+  return num_div(N(p), N(q));
+}
+Value F(double d) {
+  return Value::flonum(d);
+}
+
+Value apply(Op op, std::initializer_list<Value> args) {
+  gcvec<Value> v(args);
+  return symbolic_apply(op, v.data(), static_cast<int>(v.size()));
+}
+Value add(std::initializer_list<Value> a) {
+  return apply(Op::Add, a);
+}
+Value sub(std::initializer_list<Value> a) {
+  return apply(Op::Sub, a);
+}
+Value mul(std::initializer_list<Value> a) {
+  return apply(Op::Mul, a);
+}
+Value div(std::initializer_list<Value> a) {
+  return apply(Op::Div, a);
+}
+Value expt(Value b, Value e) {
+  return apply(Op::Expt, {b, e});
+}
+Value square(Value x) {
+  return expt(x, N(2));
+}
+Value fn(Op op, Value x) {
+  return apply(op, {x});
+}
+Value read_datum(const char *text) {
+  return read_all(register_source("<simplify_test>", text))[0].datum;
+}
+
+// An unknown function applied: (f x ...), the function given as a datum.
+Value call(const char *head_datum, std::initializer_list<Value> args) {
+  Value head = datum_to_expression(read_datum(head_datum));
+  gcvec<Value> v(args);
+  return symbolic_call(head, v.data(), static_cast<int>(v.size()));
+}
+
+std::string pe(Value v) {
+  return write_string(expression_to_datum(v));
+}
+
+TEST(Simplify, LikeTermsAndExpansion) {
+  Value a = S("a"), b = S("b");
+  EXPECT_EQ(pe(add({a, a})), "(* 2 a)");
+  EXPECT_EQ(pe(mul({add({a, b}), add({a, b})})), "(+ (expt a 2) (* 2 a b) (expt b 2))");
+  EXPECT_EQ(pe(sub({a, a})), "0");
+  EXPECT_EQ(pe(sub({add({a, N(1)}), a})), "1");
+}
+
+TEST(Simplify, RationalFunctions) {
+  Value x = S("x"), k = S("k"), m = S("m");
+  EXPECT_EQ(pe(div({sub({mul({x, x}), N(1)}), sub({x, N(1)})})), "(+ 1 x)");
+  EXPECT_EQ(pe(div({mul({N(-1), k, x}), m})), "(/ (* -1 k x) m)");
+  EXPECT_EQ(pe(div({x, mul({N(2), m})})), "(/ (* 1/2 x) m)");
+  EXPECT_EQ(pe(div({add({mul({N(4), x}), N(5)}), N(3)})), "(+ 5/3 (* 4/3 x))");
+  EXPECT_EQ(pe(div({mul({S("a"), S("b")}), mul({S("b"), S("c")})})), "(/ a c)");
+  // A polynomial denominator: integer coefficients, first term positive.
+  EXPECT_EQ(pe(div({x, sub({mul({N(2), S("b")}), mul({N(4), S("a")})})})),
+            "(/ (* -1 x) (+ (* 4 a) (* -2 b)))");
+  EXPECT_EQ(pe(div({N(1), add({S("a"), S("b")})})), "(/ 1 (+ a b))");
+  EXPECT_EQ(pe(add({div({N(1), x}), div({N(1), S("y")})})), "(/ (+ x y) (* x y))");
+}
+
+TEST(Simplify, ScmutilsTermAndFactorOrder) {
+  Value m = S("m"), t = S("t");
+  Value dx = call("(D x)", {t}), dy = call("(D y)", {t});
+  Value L = add({mul({Q(1, 2), m, square(dx)}), mul({Q(1, 2), m, square(dy)})});
+  EXPECT_EQ(pe(L), "(+ (* 1/2 m (expt ((D x) t) 2)) (* 1/2 m (expt ((D y) t) 2)))");
+  Value ddx = call("((expt D 2) x)", {t});
+  EXPECT_EQ(pe(add({mul({ddx, m}), mul({S("k"), call("x", {t})})})),
+            "(+ (* k (x t)) (* m (((expt D 2) x) t)))");
+  Value phidot = S("phidot"), r = S("r"), rdot = S("rdot");
+  Value e = add({mul({Q(1, 2), m, square(rdot)}), mul({Q(1, 2), m, square(phidot), square(r)}),
+                 mul({N(-1), call("U", {r})})});
+  EXPECT_EQ(pe(e), "(+ (* 1/2 m (expt phidot 2) (expt r 2)) (* 1/2 m (expt rdot 2)) (* -1 (U r)))");
+  Value f_x = call("f", {S("x")});
+  EXPECT_EQ(pe(sub({call("((expt D 2) f)", {S("x")}), f_x})),
+            "(+ (((expt D 2) f) x) (* -1 (f x)))");
+}
+
+TEST(Simplify, Trigonometry) {
+  Value x = S("x"), m = S("m");
+  Value s2 = square(fn(Op::Sin, x)), c2 = square(fn(Op::Cos, x));
+  EXPECT_EQ(pe(add({s2, c2})), "1");
+  EXPECT_EQ(pe(mul({m, add({s2, c2})})), "m");
+  EXPECT_EQ(pe(sub({N(1), s2})), "(expt (cos x) 2)");
+  EXPECT_EQ(pe(add({mul({S("A"), s2}), mul({S("C"), c2})})),
+            "(+ (* A (expt (sin x) 2)) (* C (expt (cos x) 2)))");
+  EXPECT_EQ(pe(fn(Op::Sin, sub({N(0), x}))), "(* -1 (sin x))");
+  EXPECT_EQ(pe(fn(Op::Cos, mul({N(-1), x}))), "(cos x)");
+  EXPECT_EQ(pe(fn(Op::Sin, add({x, x}))), "(sin (* 2 x))");
+  EXPECT_EQ(pe(fn(Op::Sin, sub({x, x}))), "0");
+  EXPECT_EQ(pe(fn(Op::Asin, fn(Op::Sin, x))), "x");
+}
+
+TEST(Simplify, RootsExpAndLog) {
+  Value x = S("x"), y = S("y");
+  EXPECT_EQ(pe(expt(fn(Op::Sqrt, x), N(2))), "x");
+  EXPECT_EQ(pe(expt(fn(Op::Sqrt, x), N(3))), "(* x (sqrt x))");
+  EXPECT_EQ(pe(div({x, fn(Op::Sqrt, x)})), "(sqrt x)");
+  EXPECT_EQ(pe(div({N(1), fn(Op::Sqrt, x)})), "(/ 1 (sqrt x))");
+  EXPECT_EQ(pe(expt(x, Q(1, 2))), "(sqrt x)");
+  // Inside the simplifier (sqrt 2) stays exact and squares to 2.
+  Value root2 = fn(Op::Sqrt, add({x, N(2), mul({N(-1), x})}));
+  EXPECT_EQ(pe(root2), "(sqrt 2)");
+  EXPECT_EQ(pe(mul({root2, root2})), "2");
+  EXPECT_EQ(pe(fn(Op::Sqrt, add({x, N(4), mul({N(-1), x})}))), "2");
+  EXPECT_EQ(pe(fn(Op::Sqrt, add({square(x), square(y)}))), "(sqrt (+ (expt x 2) (expt y 2)))");
+  EXPECT_EQ(pe(fn(Op::Exp, fn(Op::Log, x))), "x");
+  EXPECT_EQ(pe(fn(Op::Log, fn(Op::Exp, x))), "x");
+  EXPECT_EQ(pe(fn(Op::Exp, add({x, y}))), "(* (exp x) (exp y))");
+  EXPECT_EQ(pe(sub({fn(Op::Exp, mul({N(2), x})), square(fn(Op::Exp, x))})), "0");
+  EXPECT_EQ(pe(mul({fn(Op::Exp, x), fn(Op::Exp, sub({y, x}))})), "(exp y)");
+  EXPECT_EQ(pe(fn(Op::Exp, mul({N(2), fn(Op::Log, x)}))), "(expt x 2)");
+}
+
+TEST(Simplify, NumbersFoldAsSchemeDoes) {
+  EXPECT_EQ(pe(add({N(1), N(2)})), "3");
+  EXPECT_EQ(pe(fn(Op::Sin, N(0))), "0");
+  EXPECT_EQ(pe(fn(Op::Sqrt, N(4))), "2");
+  EXPECT_EQ(pe(mul({N(0), S("x")})), "0");
+  EXPECT_EQ(pe(add({S("x"), N(0)})), "x");
+  EXPECT_EQ(pe(mul({N(1), S("x")})), "x");
+  EXPECT_THROW(div({S("x"), N(0)}), Error);
+  EXPECT_THROW(simplify_value(div({S("x"), sub({S("y"), S("y")})})), Error);
+}
+
+TEST(Simplify, FlonumsMakeTheResultInexact) {
+  Value x = S("x"), y = S("y");
+  EXPECT_EQ(pe(add({mul({F(2.5), x}), mul({F(1.5), x})})), "(* 4. x)");
+  EXPECT_EQ(pe(add({mul({F(2.0), x}), y})), "(+ (* 2. x) y)");
+  EXPECT_EQ(pe(add({mul({F(0.5), x}), mul({F(-1.5), x})})), "(* -1 x)");
+  EXPECT_EQ(pe(add({x, F(1.5), mul({N(-1), x})})), "1.5");
+}
+
+TEST(Simplify, IdempotentAndMemoized) {
+  Value x = S("x"), y = S("y");
+  Value e = div({add({square(fn(Op::Sin, x)), y}), sub({x, mul({N(3), y})})});
+  Value s = simplify_value(e);
+  ASSERT_TRUE(s.is(Tag::Expr));
+  EXPECT_TRUE(expr_is_canonical(static_cast<ExprId>(s.i)));
+  EXPECT_TRUE(eq(simplify_value(s), s));
+  EXPECT_TRUE(eq(simplify_value(e), s));
+}
+
+// The kinetic energy of a rigid body in Euler angles, computed as the book
+// does: the angular velocity from M^T Mdot with M = Rz(phi) Rx(theta) Rz(psi).
+using Mat = std::array<std::array<Value, 3>, 3>;
+
+Mat mat_mul(const Mat &a, const Mat &b) {
+  Mat c;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      Value s = N(0);
+      for (int k = 0; k < 3; k++)
+        s = add({s, mul({a[i][k], b[k][j]})});
+      c[i][j] = s;
+    }
+  return c;
+}
+Mat mat_add(const Mat &a, const Mat &b) {
+  Mat c;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      c[i][j] = add({a[i][j], b[i][j]});
+  return c;
+}
+Mat mat_scale(Value k, const Mat &a) {
+  Mat c;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      c[i][j] = mul({k, a[i][j]});
+  return c;
+}
+Mat transpose(const Mat &a) {
+  Mat c;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      c[i][j] = a[j][i];
+  return c;
+}
+Mat rot_z(Value a, bool derivative) {
+  Value s = fn(Op::Sin, a), c = fn(Op::Cos, a), ms = mul({N(-1), s}), mc = mul({N(-1), c});
+  if (derivative) return Mat{{{ms, mc, N(0)}, {c, ms, N(0)}, {N(0), N(0), N(0)}}};
+  return Mat{{{c, ms, N(0)}, {s, c, N(0)}, {N(0), N(0), N(1)}}};
+}
+Mat rot_x(Value a, bool derivative) {
+  Value s = fn(Op::Sin, a), c = fn(Op::Cos, a), ms = mul({N(-1), s}), mc = mul({N(-1), c});
+  if (derivative) return Mat{{{N(0), N(0), N(0)}, {N(0), ms, mc}, {N(0), c, ms}}};
+  return Mat{{{N(1), N(0), N(0)}, {N(0), c, ms}, {N(0), s, c}}};
+}
+
+TEST(Simplify, RigidBodyKineticEnergyIsFast) {
+  Value phi = S("phi"), theta = S("theta"), psi = S("psi");
+  Value phidot = S("phidot"), thetadot = S("thetadot"), psidot = S("psidot");
+  Mat M = mat_mul(mat_mul(rot_z(phi, false), rot_x(theta, false)), rot_z(psi, false));
+  Mat Mdot = mat_add(
+      mat_add(mat_scale(phidot,
+                        mat_mul(mat_mul(rot_z(phi, true), rot_x(theta, false)), rot_z(psi, false))),
+              mat_scale(thetadot, mat_mul(mat_mul(rot_z(phi, false), rot_x(theta, true)),
+                                          rot_z(psi, false)))),
+      mat_scale(psidot,
+                mat_mul(mat_mul(rot_z(phi, false), rot_x(theta, false)), rot_z(psi, true))));
+  Mat W = mat_mul(transpose(M), Mdot);
+  Value w[3] = {W[2][1], W[0][2], W[1][0]};
+  Value T = mul({Q(1, 2), add({mul({S("A"), square(w[0])}), mul({S("B"), square(w[1])}),
+                               mul({S("C"), square(w[2])})})});
+  auto start = std::chrono::steady_clock::now();
+  Value simplified = simplify_value(T);
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 0.5);
+  RecordProperty("simplify_seconds", std::to_string(seconds));
+  // The same energy from the book's omega-body formulas.
+  Value sin_psi = fn(Op::Sin, psi), cos_psi = fn(Op::Cos, psi), sin_theta = fn(Op::Sin, theta);
+  Value a = add({mul({thetadot, cos_psi}), mul({phidot, sin_theta, sin_psi})});
+  Value b = add({mul({N(-1), thetadot, sin_psi}), mul({phidot, sin_theta, cos_psi})});
+  Value c = add({mul({phidot, fn(Op::Cos, theta)}), psidot});
+  Value T2 =
+      mul({Q(1, 2),
+           add({mul({S("A"), square(a)}), mul({S("B"), square(b)}), mul({S("C"), square(c)})})});
+  EXPECT_EQ(pe(sub({simplified, T2})), "0");
+  EXPECT_EQ(pe(simplified), pe(T2));
+  // omega-c, the simplest component.
+  EXPECT_EQ(pe(w[2]), "(+ (* phidot (cos theta)) psidot)");
+}
+
+} // namespace
+} // namespace sicm
