@@ -30,7 +30,7 @@ RUNTIME_SRCS  := $(wildcard runtime/src/*.c)
 UNIT_SRCS     := $(wildcard tests/unit/*.cpp)
 
 # The standard library, embedded in the binary; listed in load order.
-STDLIB_FILES  := stdlib/prelude.sicm
+STDLIB_FILES  := stdlib/prelude.sicm stdlib/local.sicm
 STDLIB_GEN    := $(BUILD)/gen/stdlib_embed.cpp
 
 COMPILER_OBJS := $(COMPILER_SRCS:%.cpp=$(BUILD)/%.o) $(BUILD)/gen/stdlib_embed.o

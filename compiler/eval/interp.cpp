@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <unordered_set>
 
+#include "algebra/differential.hpp"
 #include "algebra/generic.hpp"
+#include "algebra/operator.hpp"
 #include "algebra/symbolic.hpp"
 #include "eval/analyze.hpp"
 #include "eval/builtins.hpp"
@@ -80,6 +82,9 @@ void init_interpreter() {
   install_show_primitives();
   install_algebra_primitives();
   install_generic_primitives();
+  register_differential_arith();
+  install_operator_primitives();
+  install_literal_function_primitives();
   load_embedded_stdlib();
 }
 

@@ -1,0 +1,345 @@
+// Differential objects and their arithmetic: the chain rule, once per operation.
+//
+// Approach. Sums and products work on whole term lists (merge; pairwise
+// products whose tag sets are disjoint). Every other operation f is applied
+// by splitting its argument on its largest tag e, a = a0 + a1·e, and
+// computing f(a) = f(a0) + f'(a0)·a1·e, where f(a0) and f'(a0) go back
+// through generic arithmetic (a0 may still carry smaller tags, which is how
+// higher derivatives arise). Splitting on the largest tag makes the result
+// independent of the order in which nested derivatives introduced their tags.
+#include "algebra/differential.hpp"
+
+#include <algorithm>
+
+#include "algebra/generic.hpp"
+#include "algebra/structure.hpp"
+#include "eval/primitive.hpp"
+#include "eval/procedure.hpp"
+#include "print/printer.hpp"
+
+namespace sicm {
+
+namespace {
+
+struct DTerm {
+  const uint32_t *tags; // strictly increasing; GC atomic memory
+  uint32_t ntags;
+  Value coef;
+};
+
+struct Differential {
+  DTerm *terms; // GC memory
+  size_t n;
+};
+
+uint32_t g_next_tag = 1;
+
+void write_differential(std::string &out, const void *obj, bool display);
+const OpaqueKind kDifferentialKind = {"differential", write_differential, nullptr};
+
+Differential *as_diff(Value v) {
+  return static_cast<Differential *>(v.as<Opaque>()->obj);
+}
+
+bool tags_less(const DTerm &a, const DTerm &b) {
+  if (a.ntags != b.ntags) return a.ntags < b.ntags;
+  return std::lexicographical_compare(a.tags, a.tags + a.ntags, b.tags, b.tags + b.ntags);
+}
+
+bool tags_equal(const DTerm &a, const DTerm &b) {
+  return a.ntags == b.ntags && std::equal(a.tags, a.tags + a.ntags, b.tags);
+}
+
+bool has_tag(const DTerm &t, uint32_t tag) {
+  return std::binary_search(t.tags, t.tags + t.ntags, tag);
+}
+
+const uint32_t *copy_tags(const uint32_t *tags, uint32_t n) {
+  uint32_t *mem = static_cast<uint32_t *>(GC_MALLOC_ATOMIC(sizeof(uint32_t) * (n ? n : 1)));
+  std::copy(tags, tags + n, mem);
+  return mem;
+}
+
+// The terms of any value: a differential's own, or one untagged term.
+gcvec<DTerm> terms_of(Value v) {
+  if (is_differential(v)) {
+    Differential *d = as_diff(v);
+    return gcvec<DTerm>(d->terms, d->terms + d->n);
+  }
+  return gcvec<DTerm>{DTerm{nullptr, 0, v}};
+}
+
+// Build a value from terms: sorts, merges equal tag sets, drops exact zeros,
+// and collapses to a plain value when no infinitesimal is left.
+Value from_terms(gcvec<DTerm> terms) {
+  std::stable_sort(terms.begin(), terms.end(), tags_less);
+  gcvec<DTerm> merged;
+  for (const DTerm &t : terms) {
+    if (!merged.empty() && tags_equal(merged.back(), t))
+      merged.back().coef = g_add(merged.back().coef, t.coef);
+    else
+      merged.push_back(t);
+  }
+  gcvec<DTerm> kept;
+  for (const DTerm &t : merged)
+    if (!is_exact_zero(t.coef)) kept.push_back(t);
+  if (kept.empty()) return Value::fixnum(0);
+  if (kept.size() == 1 && kept[0].ntags == 0) return kept[0].coef;
+  bool tagged = false;
+  for (const DTerm &t : kept)
+    tagged |= t.ntags > 0;
+  if (!tagged) return kept[0].coef;
+  Differential *d = gc_new<Differential>();
+  d->n = kept.size();
+  d->terms = static_cast<DTerm *>(GC_MALLOC(sizeof(DTerm) * d->n));
+  std::copy(kept.begin(), kept.end(), d->terms);
+  return Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kDifferentialKind, d}));
+}
+
+Value diff_add(Value a, Value b, bool subtract) {
+  gcvec<DTerm> terms = terms_of(a);
+  for (DTerm t : terms_of(b)) {
+    if (subtract) t.coef = g_neg(t.coef);
+    terms.push_back(t);
+  }
+  return from_terms(std::move(terms));
+}
+
+Value diff_mul(Value a, Value b) {
+  gcvec<DTerm> out;
+  for (const DTerm &x : terms_of(a)) {
+    for (const DTerm &y : terms_of(b)) {
+      // e_t² = 0: terms sharing a tag vanish.
+      std::vector<uint32_t> tags;
+      std::set_union(x.tags, x.tags + x.ntags, y.tags, y.tags + y.ntags, std::back_inserter(tags));
+      if (tags.size() != x.ntags + y.ntags) continue;
+      out.push_back(DTerm{copy_tags(tags.data(), uint32_t(tags.size())), uint32_t(tags.size()),
+                          g_mul(x.coef, y.coef)});
+    }
+  }
+  return from_terms(std::move(out));
+}
+
+// f'(x) for the unary operations that are not linear.
+Value unary_derivative(UnaryOp op, Value x) {
+  Value one = Value::fixnum(1);
+  switch (op) {
+  case UnaryOp::Invert: return g_neg(g_unary(UnaryOp::Invert, g_square(x)));
+  case UnaryOp::Sqrt:
+    return g_unary(UnaryOp::Invert, g_mul(Value::fixnum(2), g_unary(UnaryOp::Sqrt, x)));
+  case UnaryOp::Exp: return g_unary(UnaryOp::Exp, x);
+  case UnaryOp::Log: return g_unary(UnaryOp::Invert, x);
+  case UnaryOp::Sin: return g_unary(UnaryOp::Cos, x);
+  case UnaryOp::Cos: return g_neg(g_unary(UnaryOp::Sin, x));
+  case UnaryOp::Tan: return g_unary(UnaryOp::Invert, g_square(g_unary(UnaryOp::Cos, x)));
+  case UnaryOp::Asin:
+    return g_unary(UnaryOp::Invert, g_unary(UnaryOp::Sqrt, g_sub(one, g_square(x))));
+  case UnaryOp::Acos:
+    return g_neg(g_unary(UnaryOp::Invert, g_unary(UnaryOp::Sqrt, g_sub(one, g_square(x)))));
+  case UnaryOp::Atan: return g_unary(UnaryOp::Invert, g_add(one, g_square(x)));
+  case UnaryOp::Abs:
+  case UnaryOp::Magnitude: return g_div(x, g_unary(UnaryOp::Abs, x));
+  case UnaryOp::Square: return g_mul(Value::fixnum(2), x);
+  case UnaryOp::Cube: return g_mul(Value::fixnum(3), g_square(x));
+  case UnaryOp::Neg:
+  case UnaryOp::ZeroP: break;
+  }
+  internal_failure(__FILE__, __LINE__, "no derivative rule for a linear operation");
+}
+
+Value diff_unary(UnaryOp op, Value x) {
+  if (op == UnaryOp::Neg) {
+    gcvec<DTerm> terms = terms_of(x);
+    for (DTerm &t : terms)
+      t.coef = g_neg(t.coef);
+    return from_terms(std::move(terms));
+  }
+  if (op == UnaryOp::ZeroP) return Value::boolean(false); // it has an infinitesimal part
+  uint32_t e = max_differential_tag(x);
+  Value x0, x1;
+  split_differential(x, e, &x0, &x1);
+  Value fx0 = g_unary(op, x0);
+  return g_add(fx0, times_infinitesimal(g_mul(unary_derivative(op, x0), x1), e));
+}
+
+Value diff_expt(Value base, Value exponent) {
+  if (!is_differential(exponent)) {
+    if (is_exact_zero(exponent)) return Value::fixnum(1);
+    uint32_t e = max_differential_tag(base);
+    Value b0, b1;
+    split_differential(base, e, &b0, &b1);
+    Value n_minus_1 = g_sub(exponent, Value::fixnum(1));
+    Value slope = g_mul(exponent, g_expt(b0, n_minus_1));
+    return g_add(g_expt(b0, exponent), times_infinitesimal(g_mul(slope, b1), e));
+  }
+  // a^b = exp(b log a) when the exponent varies.
+  return g_unary(UnaryOp::Exp, g_mul(exponent, g_unary(UnaryOp::Log, base)));
+}
+
+Value diff_atan2(Value y, Value x) {
+  uint32_t e = std::max(max_differential_tag(y), max_differential_tag(x));
+  Value y0, y1, x0, x1;
+  split_differential(y, e, &y0, &y1);
+  split_differential(x, e, &x0, &x1);
+  Value slope = g_div(g_sub(g_mul(x0, y1), g_mul(y0, x1)), g_add(g_square(x0), g_square(y0)));
+  return g_add(g_binary(BinaryOp::Atan2, y0, x0), times_infinitesimal(slope, e));
+}
+
+Value diff_binary(BinaryOp op, Value a, Value b) {
+  if (!is_arithmetic(a)) arith_wrong_type(op, a, 1);
+  if (!is_arithmetic(b)) arith_wrong_type(op, b, 2);
+  switch (op) {
+  case BinaryOp::Add: return diff_add(a, b, false);
+  case BinaryOp::Sub: return diff_add(a, b, true);
+  case BinaryOp::Mul: return diff_mul(a, b);
+  case BinaryOp::Div: return diff_mul(a, g_unary(UnaryOp::Invert, b));
+  case BinaryOp::Expt: return diff_expt(a, b);
+  case BinaryOp::Atan2: return diff_atan2(a, b);
+  case BinaryOp::Equal: {
+    gcvec<DTerm> ta = terms_of(a), tb = terms_of(b);
+    if (ta.size() != tb.size()) return Value::boolean(false);
+    for (size_t i = 0; i < ta.size(); ++i)
+      if (!tags_equal(ta[i], tb[i]) || !g_equal(ta[i].coef, tb[i].coef))
+        return Value::boolean(false);
+    return Value::boolean(true);
+  }
+  }
+  internal_failure(__FILE__, __LINE__, "unknown binary operation");
+}
+
+void write_differential(std::string &out, const void *obj, bool display) {
+  const Differential *d = static_cast<const Differential *>(obj);
+  out += "[differential";
+  for (size_t i = 0; i < d->n; ++i) {
+    out += " (";
+    for (uint32_t k = 0; k < d->terms[i].ntags; ++k) {
+      if (k) out += ' ';
+      out += std::to_string(d->terms[i].tags[k]);
+    }
+    out += ") ";
+    print_value(out, d->terms[i].coef, display);
+  }
+  out += "]";
+}
+
+bool member(Value v) {
+  return is_differential(v);
+}
+
+const ArithType kDifferentialArith = {"differential", 15, member, diff_unary, diff_binary};
+
+Value extract_from_procedure_result(NativeProc *self, Value *args, int nargs) {
+  Value r = apply_procedure(self->a, args, nargs);
+  return extract_tangent(r, static_cast<uint32_t>(self->op));
+}
+
+} // namespace
+
+bool is_differential(Value v) {
+  return v.is(Tag::Opaque) && v.as<Opaque>()->kind == &kDifferentialKind;
+}
+
+uint32_t fresh_differential_tag() {
+  return g_next_tag++;
+}
+
+Value times_infinitesimal(Value tangent, uint32_t tag) {
+  gcvec<DTerm> terms = terms_of(tangent);
+  for (DTerm &t : terms) {
+    SICM_ASSERT(!has_tag(t, tag));
+    std::vector<uint32_t> tags(t.tags, t.tags + t.ntags);
+    tags.insert(std::upper_bound(tags.begin(), tags.end(), tag), tag);
+    t.tags = copy_tags(tags.data(), uint32_t(tags.size()));
+    t.ntags = uint32_t(tags.size());
+  }
+  return from_terms(std::move(terms));
+}
+
+Value add_infinitesimal(Value x, uint32_t tag) {
+  return g_add(x, times_infinitesimal(Value::fixnum(1), tag));
+}
+
+uint32_t max_differential_tag(Value v) {
+  if (is_differential(v)) {
+    uint32_t m = 0;
+    Differential *d = as_diff(v);
+    for (size_t i = 0; i < d->n; ++i)
+      if (d->terms[i].ntags) m = std::max(m, d->terms[i].tags[d->terms[i].ntags - 1]);
+    return m;
+  }
+  if (is_structure(v)) {
+    uint32_t m = 0;
+    Structure *s = as_structure(v);
+    for (size_t i = 0; i < s->len; ++i)
+      m = std::max(m, max_differential_tag(s->items[i]));
+    return m;
+  }
+  if (is_matrix(v)) {
+    uint32_t m = 0;
+    Matrix *mat = as_matrix(v);
+    for (size_t i = 0; i < mat->rows * mat->cols; ++i)
+      m = std::max(m, max_differential_tag(mat->items[i]));
+    return m;
+  }
+  return 0;
+}
+
+void split_differential(Value v, uint32_t tag, Value *finite, Value *tangent) {
+  if (is_structure(v)) {
+    Structure *s = as_structure(v);
+    Value f = make_structure(s->up, s->len), t = make_structure(s->up, s->len);
+    for (size_t i = 0; i < s->len; ++i)
+      split_differential(s->items[i], tag, &as_structure(f)->items[i], &as_structure(t)->items[i]);
+    *finite = f;
+    *tangent = t;
+    return;
+  }
+  if (!is_differential(v)) {
+    *finite = v;
+    *tangent = Value::fixnum(0);
+    return;
+  }
+  gcvec<DTerm> fin, tan;
+  for (const DTerm &t : terms_of(v)) {
+    if (!has_tag(t, tag)) {
+      fin.push_back(t);
+      continue;
+    }
+    std::vector<uint32_t> tags;
+    for (uint32_t k = 0; k < t.ntags; ++k)
+      if (t.tags[k] != tag) tags.push_back(t.tags[k]);
+    tan.push_back(
+        DTerm{copy_tags(tags.data(), uint32_t(tags.size())), uint32_t(tags.size()), t.coef});
+  }
+  *finite = from_terms(std::move(fin));
+  *tangent = from_terms(std::move(tan));
+}
+
+Value extract_tangent(Value v, uint32_t tag) {
+  if (is_structure(v)) {
+    Structure *s = as_structure(v);
+    Value out = make_structure(s->up, s->len);
+    for (size_t i = 0; i < s->len; ++i)
+      as_structure(out)->items[i] = extract_tangent(s->items[i], tag);
+    return out;
+  }
+  if (is_matrix(v)) {
+    Matrix *m = as_matrix(v);
+    Value out = make_matrix(m->rows, m->cols);
+    for (size_t i = 0; i < m->rows * m->cols; ++i)
+      as_matrix(out)->items[i] = extract_tangent(m->items[i], tag);
+    return out;
+  }
+  if (is_procedure(v))
+    return make_native_procedure(extract_from_procedure_result, static_cast<int>(tag), v,
+                                 Value::unspecified());
+  Value finite, tangent;
+  split_differential(v, tag, &finite, &tangent);
+  return tangent;
+}
+
+void register_differential_arith() {
+  register_arith_type(&kDifferentialArith);
+}
+
+} // namespace sicm

@@ -1,0 +1,46 @@
+// Differential objects: forward-mode automatic differentiation with tagged
+// infinitesimals, as in scmutils.
+//
+// A differential is a finite sum of terms c·e_{t1}·e_{t2}···, each an
+// ordinary value c (number, expression, structure component) times a product
+// of distinct infinitesimals e_t (with e_t² = 0), identified by integer tags.
+// D makes a fresh tag for each derivative it takes, so derivatives nested
+// inside derivatives never confuse their infinitesimals (the "perturbation
+// confusion" of naive dual numbers): only terms carrying D's own tag are
+// extracted.
+//
+// Invariants (checked by make_differential in debug builds):
+//   - terms are sorted by tag set (shorter first, then lexicographically);
+//   - tag sets are strictly increasing lists and no two terms share one;
+//   - no coefficient is an exact zero;
+//   - at least one term has a non-empty tag set (otherwise the value is just
+//     the coefficient of the empty set, and no differential is made).
+#pragma once
+
+#include <cstdint>
+
+#include "eval/value.hpp"
+
+namespace sicm {
+
+bool is_differential(Value v);
+// A fresh infinitesimal tag (never reused).
+uint32_t fresh_differential_tag();
+// x + e_tag.
+Value add_infinitesimal(Value x, uint32_t tag);
+// The coefficient of e_tag in v: terms of v carrying the tag, with the tag
+// removed. Maps over structures and matrices, and over procedure results (a
+// procedure-valued v gives a procedure). Values without the tag give 0.
+Value extract_tangent(Value v, uint32_t tag);
+// The largest tag in v (searching structures and matrices), or 0 if none.
+uint32_t max_differential_tag(Value v);
+// v with every term carrying `tag` dropped (the finite part in that tag),
+// and the coefficient of the tag, so that v = finite + tangent·e_tag.
+void split_differential(Value v, uint32_t tag, Value *finite, Value *tangent);
+// tangent·e_tag (the tangent must not carry the tag).
+Value times_infinitesimal(Value tangent, uint32_t tag);
+
+// Register the differential arithmetic type with generic arithmetic.
+void register_differential_arith();
+
+} // namespace sicm
