@@ -14,6 +14,7 @@
 #include "algebra/differential.hpp"
 #include "algebra/generic.hpp"
 #include "algebra/operator.hpp"
+#include "algebra/series.hpp"
 #include "algebra/structure.hpp"
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
@@ -89,7 +90,15 @@ Value derivative_apply(NativeProc *self, Value *argv, int nargs) {
 
 // ---- operators ---------------------------------------------------------------
 
-enum class OperatorKind { Derivative, Compose, Sum, Scale, Identity };
+enum class OperatorKind {
+  Derivative,
+  Compose,
+  Sum,
+  Scale,
+  Identity,
+  Exp,    // (exp x): applied to f, the series sum_k x^k f / k!
+  Custom, // made by make-operator from a procedure on functions
+};
 
 struct Operator {
   OperatorKind kind;
@@ -139,6 +148,9 @@ Value operator_unary(UnaryOp op, Value x) {
   if (op == UnaryOp::Neg)
     return make_operator(OperatorKind::Scale, list({intern("-"), as_operator(x)->name}),
                          Value::fixnum(-1), x);
+  if (op == UnaryOp::Exp)
+    return make_operator(OperatorKind::Exp, list({intern("exp"), as_operator(x)->name}), x,
+                         Value());
   arith_wrong_type(op, x);
 }
 
@@ -224,6 +236,13 @@ Value P_operator_p(Value *a, int) {
   return Value::boolean(is_operator(a[0]));
 }
 
+// (make-operator procedure [name]): an operator from a procedure that maps
+// functions to functions, so that operator arithmetic (and exp) apply to it.
+Value P_make_operator(Value *a, int n) {
+  if (!is_procedure(a[0])) wrong_type(a[0], 1, "make-operator");
+  return make_operator(OperatorKind::Custom, n > 1 ? a[1] : intern("operator"), a[0], Value());
+}
+
 } // namespace
 
 bool is_operator(Value v) {
@@ -251,6 +270,8 @@ Value apply_operator(Value opv, Value f) {
   case OperatorKind::Sum: return g_add(apply_operator(op->a, f), apply_operator(op->b, f));
   case OperatorKind::Scale: return g_mul(op->a, apply_operator(op->b, f));
   case OperatorKind::Identity: return f;
+  case OperatorKind::Exp: return make_exp_series(op->a, f);
+  case OperatorKind::Custom: return apply_procedure(op->a, &f, 1);
   }
   internal_failure(__FILE__, __LINE__, "unknown operator kind");
 }
@@ -261,6 +282,7 @@ void install_operator_primitives() {
   define_primitive("partial", 1, kVariadic, P_partial);
   define_primitive("derivative", 1, 1, P_derivative);
   define_primitive("operator?", 1, 1, P_operator_p);
+  define_primitive("make-operator", 1, 2, P_make_operator);
   define_global("I", identity_operator());
 }
 

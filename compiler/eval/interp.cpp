@@ -8,6 +8,7 @@
 #include "algebra/differential.hpp"
 #include "algebra/generic.hpp"
 #include "algebra/operator.hpp"
+#include "algebra/series.hpp"
 #include "algebra/symbolic.hpp"
 #include "eval/analyze.hpp"
 #include "eval/builtins.hpp"
@@ -85,6 +86,7 @@ void init_interpreter() {
   register_differential_arith();
   install_operator_primitives();
   install_literal_function_primitives();
+  install_series_primitives();
   load_embedded_stdlib();
 }
 
