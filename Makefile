@@ -30,7 +30,8 @@ RUNTIME_SRCS  := $(wildcard runtime/src/*.c)
 UNIT_SRCS     := $(wildcard tests/unit/*.cpp)
 
 # The standard library, embedded in the binary; listed in load order.
-STDLIB_FILES  := stdlib/prelude.sicm stdlib/local.sicm
+STDLIB_FILES  := $(addprefix stdlib/,prelude.sicm local.sicm numerics.sicm lagrangian.sicm \
+                   rigid-body.sicm hamiltonian.sicm maps.sicm canonical.sicm lie.sicm)
 STDLIB_GEN    := $(BUILD)/gen/stdlib_embed.cpp
 
 COMPILER_OBJS := $(COMPILER_SRCS:%.cpp=$(BUILD)/%.o) $(BUILD)/gen/stdlib_embed.o
