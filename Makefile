@@ -22,7 +22,7 @@ CPPFLAGS  := -Icompiler -Iruntime/include -MMD -MP
 CXXFLAGS  := -std=c++20 $(OPT) -g $(WARN) $(SANFLAGS)
 CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(SANFLAGS)
 LDFLAGS   := $(SANFLAGS)
-LIBS      := -lflint -lgc -lgmp -lreadline -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -lm -lpthread
+LIBS      := -lflint -lgc -lgmp -lreadline -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -lm -lpthread -ldl
 
 # ---- sources, per component --------------------------------------------
 COMPILER_SRCS := $(wildcard compiler/*.cpp compiler/*/*.cpp)

@@ -318,6 +318,10 @@ bool expr_is_variable(ExprId id) {
   return false;
 }
 
+bool expr_is_constant(ExprId id) {
+  return expr_is_number(id) && !expr_is_variable(id);
+}
+
 std::vector<ExprId> expr_arg_vector(ExprId id) {
   const ExprNode &n = expr_node(id);
   const ExprId *a = expr_args(id);
@@ -428,7 +432,7 @@ bool as_monomial(ExprId id, std::vector<std::pair<ExprId, int64_t>> *powers, Exp
   *coeff = kNoExpr;
   ExprId v;
   int64_t e;
-  if (expr_is_number(id)) {
+  if (expr_is_constant(id)) {
     *coeff = id;
     return !expr_is_exact_zero(id);
   }
@@ -439,7 +443,7 @@ bool as_monomial(ExprId id, std::vector<std::pair<ExprId, int64_t>> *powers, Exp
   if (!expr_is_apply(id, Op::Mul)) return false;
   const ExprNode &n = expr_node(id);
   size_t i = 0;
-  if (expr_is_number(expr_arg(id, 0))) {
+  if (expr_is_constant(expr_arg(id, 0))) {
     *coeff = expr_arg(id, 0);
     if (expr_is_exact_one(*coeff) || expr_is_exact_zero(*coeff)) return false;
     i = 1;
@@ -500,10 +504,10 @@ bool is_polynomial(ExprId id, PolyFacts *f) {
   f->single = false;
   const ExprNode &n = expr_node(id);
   // A constant term comes first (C5); the others descend.
-  uint32_t i = expr_is_number(expr_arg(id, 0)) ? 1 : 0;
+  uint32_t i = expr_is_constant(expr_arg(id, 0)) ? 1 : 0;
   if (i == 1) note(expr_arg(id, 0));
   for (uint32_t k = i; k < n.nargs; k++) {
-    if (!as_monomial(expr_arg(id, k), &cur, &coeff) || expr_is_number(expr_arg(id, k)))
+    if (!as_monomial(expr_arg(id, k), &cur, &coeff) || expr_is_constant(expr_arg(id, k)))
       return false;
     if (k == i) f->first = coeff;
     note(coeff);
@@ -524,7 +528,7 @@ bool kernel_args_canonical(ExprId id) {
 
 // Every variable inside a polynomial or quotient has canonical arguments.
 bool variables_canonical(ExprId id) {
-  if (expr_is_number(id)) return true;
+  if (expr_is_constant(id)) return true;
   if (expr_is_variable(id))
     return expr_kind(id) == ExprKind::Symbol || expr_kind(id) == ExprKind::Flonum ||
            kernel_args_canonical(id);
@@ -543,7 +547,7 @@ bool check_canonical(ExprId id) {
   PolyFacts nf, df;
   if (expr_is_apply(id, Op::Div)) {
     ExprId num = expr_arg(id, 0), den = expr_arg(id, 1);
-    ok = !expr_is_number(den) && !expr_is_exact_zero(num) && is_polynomial(num, &nf) &&
+    ok = !expr_is_constant(den) && !expr_is_exact_zero(num) && is_polynomial(num, &nf) &&
          is_polynomial(den, &df);
     if (ok && df.single) ok = df.first == kNoExpr; // C6: monomial denominator, coefficient 1
     if (ok && !df.single)

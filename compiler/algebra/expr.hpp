@@ -46,8 +46,10 @@
 //       (/ N D) of two polynomials;
 //   C2  a variable is a symbol, a non-finite flonum or a kernel: an Apply of a
 //       non-rational operator (sqrt exp log sin cos tan asin acos atan sinh
-//       cosh abs, or expt with an exponent that is not an exact integer) or a
-//       Call, whose arguments are canonical (a Call's head is left as built);
+//       cosh abs, or expt with an exponent that is not an exact integer of
+//       magnitude at most kMaxExpandedPower) or a Call, whose arguments are
+//       canonical and to which no rule of the simplifier applies (a Call's
+//       head is left as built, except that nested partials are sorted);
 //   C3  variables are totally ordered by expr_compare: symbols by name (as
 //       symbol<? orders them), then kernels;
 //   C4  a power is (expt v n) with v a variable and n an exact integer >= 2;
@@ -60,18 +62,20 @@
 //       exponent vectors, the first variable most significant, except that a
 //       constant term comes first: the order in which scmutils prints terms,
 //       (+ -1 (expt x 2) (* 2 x y));
-//   C6  in (/ N D), D is not a number; if D is a monomial its coefficient is
-//       1 (scmutils divides numbers through into N); otherwise N and D have
-//       exact integer coefficients with no common integer factor and the
-//       first term of D has a positive coefficient.
-// Inexact results are not canonical in this exact sense: the simplifier turns
-// every coefficient into a flonum when the input had a flonum (see simplify.hpp).
+//   C6  in (/ N D), N and D have no common factor, N is not 0 and D is not a
+//       number; if D is a monomial its coefficient is 1 (scmutils divides
+//       numbers through into N); otherwise N and D have exact integer
+//       coefficients with no common integer factor and the leading
+//       (highest-degree) term of D has a positive coefficient.
+// A result computed from flonums has flonum coefficients (see simplify.cpp);
+// it satisfies C1-C6 except the integrality of C6.
 #pragma once
 
 #include <gmp.h>
 
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -159,6 +163,8 @@ bool expr_is_polynomial_power(ExprId id);
 // A variable in the sense of C2: a symbol, a non-finite flonum, a Call, or an
 // Apply of an operator other than + - * / and polynomial powers.
 bool expr_is_variable(ExprId id);
+// A number that is not a variable: a rational or a finite flonum.
+bool expr_is_constant(ExprId id);
 // A copy of a node's arguments: node references and argument pointers are
 // invalidated when the arena grows, so code that builds nodes while walking
 // one takes a copy first.
@@ -169,9 +175,10 @@ std::vector<ExprId> expr_arg_vector(ExprId id);
 // arguments: numbers (by value, exact before inexact when equal) < symbols (by
 // name, bytewise) < applications. Applications are compared by head, then
 // argument by argument, then by argument count; a derived-function head such
-// as (D f) sorts before every named head, named heads (operators by their
-// Scheme name, literal functions by symbol) compare by name. Returns <0, 0, >0;
-// 0 only for the same id.
+// as (D f) sorts before every named head (so the book's
+// (+ (((expt D 2) f) x) (* -1 (f x))) comes out in its order), named heads
+// (operators by their Scheme name, literal functions by symbol) compare by
+// name. Returns <0, 0, >0; 0 only for the same id.
 int expr_compare(ExprId a, ExprId b);
 
 // ---- printing ----

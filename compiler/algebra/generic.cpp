@@ -363,7 +363,8 @@ Value prim_minus_one_plus(Value *args, int) {
 
 Value prim_compose(Value *args, int n) {
   for (int i = 0; i < n; ++i)
-    if (!is_procedure(args[i])) wrong_type(args[i], i + 1, "compose");
+    if (!is_procedure(args[i]) && !args[i].is(Tag::Structure)) // structures apply componentwise
+      wrong_type(args[i], i + 1, "compose");
   return compose_procedures(args, static_cast<size_t>(n));
 }
 

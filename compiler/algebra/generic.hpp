@@ -8,8 +8,12 @@
 // type of higher rank, which treats the other operand as a coefficient:
 //
 //   rank 10  symbolic   symbols used as numbers, expressions (algebra/symbolic.hpp)
-//   rank 20  structure  up/down tuples and matrices (algebra/structure.hpp)
+//   rank 15  differential  tagged infinitesimals of AD (algebra/differential.hpp)
 //   rank 30  function   procedures: (+ f g) is x |-> (+ (f x) (g x))
+//   rank 32  structure  up/down tuples and matrices (algebra/structure.hpp); above
+//            functions, as in scmutils: (* f (down g h)) is (down (* f g) (* f h))
+//   rank 35  series     lazy power series (algebra/series.hpp)
+//   rank 40  operator   D, partial, make-operator (algebra/operator.hpp)
 //
 // A new kind of value (differentials, operators, series) is added by
 // registering one more ArithType with a suitable rank; nothing else changes.

@@ -144,10 +144,14 @@ Value operator_apply(void *obj, Value *args, int nargs) {
   return apply_operator(self, args[0]);
 }
 
+Value compose(Value a, Value b);
+
 Value operator_unary(UnaryOp op, Value x) {
   if (op == UnaryOp::Neg)
     return make_operator(OperatorKind::Scale, list({intern("-"), as_operator(x)->name}),
                          Value::fixnum(-1), x);
+  if (op == UnaryOp::Square) return compose(x, x);
+  if (op == UnaryOp::Cube) return compose(x, compose(x, x));
   if (op == UnaryOp::Exp)
     return make_operator(OperatorKind::Exp, list({intern("exp"), as_operator(x)->name}), x,
                          Value());
@@ -196,7 +200,10 @@ Value operator_binary(BinaryOp op, Value a, Value b) {
     break;
   case BinaryOp::Add:
   case BinaryOp::Sub: {
-    if (!(oa || is_arithmetic(a)) || !(ob || is_arithmetic(b)) || is_procedure(oa ? b : a)) break;
+    // Operators add to operators and to numbers or symbols (multiples of
+    // the identity operator), not to other procedures.
+    auto addable = [](Value v) { return is_operator(v) || (is_arithmetic(v) && !is_procedure(v)); };
+    if (!addable(a) || !addable(b)) break;
     Value x = as_operator_term(a), y = as_operator_term(b);
     if (op == BinaryOp::Sub) y = scale(Value::fixnum(-1), y);
     return make_operator(OperatorKind::Sum,

@@ -9,6 +9,7 @@
 #include "algebra/polynomial.hpp"
 
 #include <flint/fmpq.h>
+#include <flint/fmpq_mpoly_factor.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -21,6 +22,8 @@ namespace sicm {
 // ---- rings and polynomials ---------------------------------------------------
 
 PolyRing::PolyRing(std::vector<ExprId> sorted_vars) : vars_(std::move(sorted_vars)) {
+  for (size_t i = 0; i < vars_.size(); i++)
+    index_.emplace(vars_[i], static_cast<int>(i));
   // FLINT wants at least one variable; a spare one is never used.
   fmpq_mpoly_ctx_init(ctx_, static_cast<slong>(std::max<size_t>(vars_.size(), 1)), ORD_DEGLEX);
 }
@@ -30,11 +33,8 @@ PolyRing::~PolyRing() {
 }
 
 int PolyRing::index_of(ExprId v) const {
-  // vars_ is sorted, but by a comparison that walks expressions; the lists are
-  // short, so a linear search by id is cheaper.
-  for (size_t i = 0; i < vars_.size(); i++)
-    if (vars_[i] == v) return static_cast<int>(i);
-  return -1;
+  auto it = index_.find(v);
+  return it == index_.end() ? -1 : it->second;
 }
 
 Poly::Poly(const PolyRing &r) : ring_(&r), p_(new fmpq_mpoly_struct) {
@@ -256,6 +256,32 @@ RatFun rf_pow(const RatFun &a, int64_t n) {
   return f;
 }
 
+void poly_split_square(const Poly &p, fmpq_t constant, Poly *root, Poly *rest) {
+  const fmpq_mpoly_ctx_struct *ctx = p.ctx();
+  fmpq_mpoly_one(root->get(), ctx);
+  fmpq_mpoly_one(rest->get(), ctx);
+  fmpq_mpoly_factor_t f;
+  fmpq_mpoly_factor_init(f, ctx);
+  if (p.is_zero() || !fmpq_mpoly_factor_squarefree(f, p.get(), ctx)) {
+    // Nothing to split (FLINT fails only on exponent overflow).
+    fmpq_mpoly_factor_clear(f, ctx);
+    fmpq_one(constant);
+    fmpq_mpoly_set(rest->get(), p.get(), ctx);
+    return;
+  }
+  fmpq_set(constant, f->constant);
+  Poly power(p.ring());
+  for (slong i = 0; i < f->num; i++) {
+    ulong e = fmpz_get_ui(f->exp + i);
+    if (e / 2) {
+      fmpq_mpoly_pow_ui(power.get(), f->poly + i, e / 2, ctx);
+      fmpq_mpoly_mul(root->get(), root->get(), power.get(), ctx);
+    }
+    if (e % 2) fmpq_mpoly_mul(rest->get(), rest->get(), f->poly + i, ctx);
+  }
+  fmpq_mpoly_factor_clear(f, ctx);
+}
+
 long poly_degree_in(const Poly &p, int v) {
   if (p.is_zero()) return 0;
   return fmpq_mpoly_degree_si(p.get(), v, p.ctx());
@@ -343,7 +369,7 @@ ExprId poly_to_expr(const Poly &p, const fmpq_t scale, bool inexact) {
   fmpq_clear(c);
   if (terms.size() == 1) return terms[0];
   // scmutils' sum constructor puts a number first: (+ -1 (expt x 2)).
-  if (expr_is_number(terms.back())) std::rotate(terms.begin(), terms.end() - 1, terms.end());
+  if (expr_is_constant(terms.back())) std::rotate(terms.begin(), terms.end() - 1, terms.end());
   return expr_apply(Op::Add, terms.data(), terms.size());
 }
 

@@ -6,7 +6,8 @@
 // back into a canonical expression (algebra/expr.hpp, C4-C6). The ring's
 // variables are sorted by expr_compare and FLINT's variable i is the ring's
 // i-th variable, so FLINT's degree-lexicographic term order (variable 0 most
-// significant) is exactly the order in which terms are printed.
+// significant) is the order in which terms are printed (but for a constant
+// term, which scmutils prints first).
 //
 // Everything here is malloc'd FLINT memory, released by destructors: no Values.
 #pragma once
@@ -14,6 +15,7 @@
 #include <flint/fmpq_mpoly.h>
 
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "algebra/expr.hpp"
@@ -35,6 +37,7 @@ public:
 
 private:
   std::vector<ExprId> vars_;
+  std::unordered_map<ExprId, int> index_;
   fmpq_mpoly_ctx_t ctx_;
 };
 
@@ -87,6 +90,11 @@ RatFun rf_pow(const RatFun &a, int64_t n); // negative powers of zero as rf_inv
 RatFun rf_reduce_square(const Poly &p, int v, const RatFun &square);
 // The same for a rational function, numerator and denominator separately.
 RatFun rf_reduce_square(const RatFun &f, int v, const RatFun &square);
+// p = constant * root^2 * rest, with root as large as squarefree
+// factorization finds: rest is the product of the factors of p of odd
+// multiplicity; root and rest have no constant factor of their own.
+void poly_split_square(const Poly &p, fmpq_t constant, Poly *root, Poly *rest);
+
 // Highest power of variable v in p (0 if absent).
 long poly_degree_in(const Poly &p, int v);
 

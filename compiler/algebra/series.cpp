@@ -158,7 +158,8 @@ Value P_series_ref(Value *a, int) {
   return series_term(a[0], arg_index(a, 1, "series:ref"));
 }
 
-// (series:sum series n): the sum of the first n terms.
+// (series:sum series n): the partial sum of terms 0 through n (n + 1 terms),
+// as scmutils defines it.
 Value P_series_sum(Value *a, int) {
   arg_series(a, 0, "series:sum");
   size_t n = arg_index(a, 1, "series:sum");

@@ -32,7 +32,8 @@
 // reciprocal of exp of its negation, exp of n x a power of (exp x)
 // (scmutils' exp-expand, so equal values get one form and products of
 // exponentials cancel); (log (sqrt x)) is
-// (* 1/2 (log x)); (expt u p/2) is a power of (sqrt u).
+// (* 1/2 (log x)); (expt u p/2) is a power of (sqrt u); (sqrt (* f^2 g)) is
+// (* f (sqrt g)).
 //
 // Flonums. Coefficients are computed exactly (a flonum is the rational it
 // denotes) and, when the rational skeleton of the input contained a flonum,
@@ -41,7 +42,9 @@
 // Flonums inside kernel arguments affect only those arguments.
 //
 // Limits. No factorization: a numerator or denominator is an expanded
-// polynomial, as in scmutils. (sqrt (expt x 2)) stays: its sign is unknown.
+// polynomial, as in scmutils. Like scmutils (sqrt-expt-simplify, its
+// default) square factors leave square roots on the assumption that they are
+// non-negative: (sqrt (expt r 2)) is r.
 // Trig identities other than sin^2 + cos^2 = 1 (multiple angles, tan as
 // sin/cos) are not applied. The memo table only grows; it is indexed by id.
 #include "algebra/simplify.hpp"
@@ -78,6 +81,7 @@ void memo_put(ExprId id, ExprId value) {
 }
 
 ExprId simplify_kernel(ExprId id);
+bool root_out_squares(ExprId x, ExprId *out);
 
 // ---- kernels -------------------------------------------------------------------
 
@@ -138,16 +142,16 @@ bool fold_numbers(Op op, const std::vector<ExprId> &args, ExprId *out) {
 // the first product of a sum).
 int leading_sign(ExprId x) {
   while (true) {
-    if (expr_is_number(x)) return expr_number_sign(x);
+    if (expr_is_constant(x)) return expr_number_sign(x);
     if (expr_is_apply(x, Op::Add)) {
-      x = expr_arg(x, expr_is_number(expr_arg(x, 0)) ? 1 : 0);
+      x = expr_arg(x, expr_is_constant(expr_arg(x, 0)) ? 1 : 0);
       continue;
     }
     if (expr_is_apply(x, Op::Div)) {
       x = expr_arg(x, 0);
       continue;
     }
-    if (expr_is_apply(x, Op::Mul) && expr_is_number(expr_arg(x, 0)))
+    if (expr_is_apply(x, Op::Mul) && expr_is_constant(expr_arg(x, 0)))
       return expr_number_sign(expr_arg(x, 0));
     return 1;
   }
@@ -237,6 +241,9 @@ ExprId kernel_rules(Op op, const std::vector<ExprId> &args) {
         expr_arg(x, 0) == expr_arg(args[1], 0))
       return expr_arg(x, 0);
     break;
+  case Op::Sqrt:
+    if (root_out_squares(x, &out)) return out;
+    break;
   case Op::Exp:
     if (expand_exp(x, &out)) return out;
     break;
@@ -269,6 +276,41 @@ ExprId kernel_rules(Op op, const std::vector<ExprId> &args) {
   return expr_apply(op, args.data(), args.size());
 }
 
+// The index list of a (partial i ...) operator, or false.
+bool partial_indices(ExprId op, std::vector<int64_t> *indices) {
+  const ExprNode &n = expr_node(op);
+  if (n.kind != ExprKind::Call) return false;
+  const ExprNode &h = expr_node(n.head);
+  if (h.kind != ExprKind::Symbol || h.sym->name != "partial") return false;
+  indices->clear();
+  for (ExprId i : expr_arg_vector(op)) {
+    int64_t v;
+    if (!expr_get_int64(i, &v)) return false;
+    indices->push_back(v);
+  }
+  return true;
+}
+
+// A derived-function head ((partial i) ((partial j) f)) with the partials
+// sorted, smaller index lists outside, so mixed partials that differ only in
+// the order of differentiation are one kernel (scmutils' canonicalize-partials,
+// with commute-partials on: it holds for the smooth functions of mechanics).
+ExprId canonical_partials(ExprId head) {
+  std::vector<int64_t> outer, inner;
+  const ExprNode &n = expr_node(head);
+  if (n.kind != ExprKind::Call || n.nargs != 1 || !partial_indices(n.head, &outer)) return head;
+  ExprId outer_op = n.head;
+  ExprId f = canonical_partials(expr_arg(head, 0));
+  const ExprNode &fn = expr_node(f);
+  if (fn.kind == ExprKind::Call && fn.nargs == 1 && partial_indices(fn.head, &inner) &&
+      std::lexicographical_compare(inner.begin(), inner.end(), outer.begin(), outer.end())) {
+    ExprId inner_op = fn.head, g = expr_arg(f, 0);
+    ExprId swapped = canonical_partials(expr_call(outer_op, &g, 1));
+    return expr_call(inner_op, &swapped, 1);
+  }
+  return expr_call(outer_op, &f, 1);
+}
+
 ExprId simplify_kernel(ExprId id) {
   const ExprNode &n = expr_node(id);
   bool is_call = n.kind == ExprKind::Call;
@@ -277,7 +319,7 @@ ExprId simplify_kernel(ExprId id) {
   std::vector<ExprId> args = expr_arg_vector(id);
   for (ExprId &a : args)
     a = simplify_expr(a);
-  if (is_call) return expr_call(head, args.data(), args.size());
+  if (is_call) return expr_call(canonical_partials(head), args.data(), args.size());
   return kernel_rules(op, args);
 }
 
@@ -432,10 +474,11 @@ public:
     }
   }
 
-  void make_ring() {
+  const PolyRing &make_ring() {
     std::sort(vars_.begin(), vars_.end(),
               [](ExprId a, ExprId b) { return expr_compare(a, b) < 0; });
     ring_ = std::make_unique<PolyRing>(vars_);
+    return *ring_;
   }
 
   // The rational function of a node (step 2), memoized for nodes used more
@@ -698,6 +741,45 @@ private:
   std::unordered_map<ExprId, RatFun> memo_;
   bool inexact_ = false;
 };
+
+// (sqrt (* f^2 g)) = (* f (sqrt g)) for the square factors f of the radicand
+// (numerator and denominator), as scmutils' root-out-squares does with
+// sqrt-expt-simplify on (its default): this assumes f >= 0, so
+// (sqrt (expt r 2)) is r.
+bool root_out_squares(ExprId x, ExprId *out) {
+  if (expr_is_number(x) || expr_is_variable(x)) return false;
+  Pass pass;
+  pass.collect(x);
+  const PolyRing &ring = pass.make_ring();
+  RatFun f = pass.convert(x);
+  Poly num_root(ring), num_rest(ring), den_root(ring), den_rest(ring);
+  fmpq_t c, cd;
+  fmpq_init(c);
+  fmpq_init(cd);
+  poly_split_square(f.num, c, &num_root, &num_rest);
+  poly_split_square(f.den, cd, &den_root, &den_rest);
+  // The constant factor as a whole leaves the root only if it is the square
+  // of a positive rational (so each rewrite shrinks the radicand, and this ends).
+  fmpq_div(c, c, cd);
+  bool square = fmpq_sgn(c) > 0 && !fmpq_is_one(c) && fmpz_is_square(fmpq_numref(c)) &&
+                fmpz_is_square(fmpq_denref(c));
+  bool changed = square || !num_root.is_one() || !den_root.is_one();
+  if (changed) {
+    if (square) {
+      fmpz_sqrt(fmpq_numref(c), fmpq_numref(c));
+      fmpz_sqrt(fmpq_denref(c), fmpq_denref(c));
+      fmpq_mpoly_scalar_mul_fmpq(num_root.get(), num_root.get(), c, ring.ctx());
+    } else {
+      fmpq_mpoly_scalar_mul_fmpq(num_rest.get(), num_rest.get(), c, ring.ctx());
+    }
+    ExprId outside = rf_to_expr(RatFun(std::move(num_root), std::move(den_root)), pass.inexact());
+    ExprId inside = rf_to_expr(RatFun(std::move(num_rest), std::move(den_rest)), pass.inexact());
+    *out = simplify_expr(expr_apply(Op::Mul, {outside, expr_apply(Op::Sqrt, {inside})}));
+  }
+  fmpq_clear(c);
+  fmpq_clear(cd);
+  return changed;
+}
 
 ExprId simplify_rational(ExprId id) {
   Pass pass;

@@ -400,7 +400,7 @@ Value structural_binary(BinaryOp op, Value a, Value b) {
   return structure_binary_ops(op, a, b);
 }
 
-const ArithType kStructureType = {"structure", 20, is_structure_or_matrix, structural_unary,
+const ArithType kStructureType = {"structure", 32, is_structure_or_matrix, structural_unary,
                                   structural_binary};
 
 } // namespace

@@ -58,7 +58,8 @@ Value simplify_value(Value v);
 Value expression_to_datum(Value v);
 
 // Register the algebra's primitives (simplify, print-expression, pe,
-// expression->datum ...). Called by init_interpreter.
+// expression, datum->expression) and the printer's converter that shows an
+// expression as its simplified prefix form. Called by init_interpreter.
 void install_algebra_primitives();
 
 } // namespace sicm

@@ -10,10 +10,12 @@
 #include "algebra/operator.hpp"
 #include "algebra/series.hpp"
 #include "algebra/symbolic.hpp"
+#include "codegen/kernel.hpp"
 #include "eval/analyze.hpp"
 #include "eval/builtins.hpp"
 #include "eval/core.hpp"
 #include "eval/number.hpp"
+#include "eval/numerics.hpp"
 #include "eval/plot.hpp"
 #include "eval/procedure.hpp"
 #include "eval/stdlib.hpp"
@@ -87,6 +89,8 @@ void init_interpreter() {
   install_operator_primitives();
   install_literal_function_primitives();
   install_series_primitives();
+  install_numerics_primitives();
+  install_kernel_primitives();
   load_embedded_stdlib();
 }
 

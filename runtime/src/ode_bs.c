@@ -191,6 +191,12 @@ static void choose_next(const bs_state *b, int a, int kc, int after_reject, cons
     *knew = kc;
     *Hnew = Hopt[kc];
   }
+  /* A step accepted at the last row (a = kMaxRow) must not target it: the
+   * next step builds rows up to target + 1, and the tableau has kMaxRow. */
+  if (*knew > kMaxRow - 1) {
+    *knew = kMaxRow - 1;
+    *Hnew = Hopt[kMaxRow - 1];
+  }
 }
 
 static int bs_evolve(sicm_ode *o, double *t, double t1, double *y) {

@@ -1,0 +1,393 @@
+// The C emitter: CSE by use counts, powers as products, sincos pairs (see emit_c.hpp).
+//
+// The outputs of a trace form a DAG in the expression arena, already shared
+// by hash-consing. The emitter walks the nodes reachable from the outputs in
+// increasing id order, which is topological (children have smaller ids), and
+// gives a name (a `const double tN`) to every operation node that is used
+// more than once, and to a few more that must be simple operands:
+//   - the base of an integer power, written as repeated products (x*x*x);
+//   - the argument of a sin and cos pair, computed by one sincos() call.
+// Everything else is written inline in the expression of its only user, with
+// parentheses exactly where C's precedence would otherwise regroup an
+// operation: floating-point arithmetic is not associative, so the C must
+// evaluate the tree as built. Sums with negated terms are written with `-`
+// (a + (-b) and a - b are the same IEEE operation). Powers with exponent of
+// magnitude 4 or more are computed by repeated squaring into temporaries;
+// negative integer powers are 1.0 divided by the positive power.
+//
+// Numbers are emitted as the double they round to (exact rationals correctly
+// rounded), in the shortest form that reads back exactly. No user text
+// reaches the C: inputs are in[i], temporaries tN, and names are sanitized.
+#include "codegen/emit_c.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "eval/number.hpp"
+#include "sicm/runtime.h"
+
+namespace sicm {
+
+namespace {
+
+// C precedence levels of the forms the emitter writes, tightest first.
+enum Prec : int { kAtom = 0, kUnary = 1, kMul = 2, kAdd = 3 };
+
+struct Code {
+  std::string text;
+  int prec;
+};
+
+// c's text, parenthesized if its precedence is looser than max_prec allows.
+std::string wrap(const Code &c, int max_prec) {
+  return c.prec > max_prec ? "(" + c.text + ")" : c.text;
+}
+
+double number_value(ExprId id) {
+  const ExprNode &n = expr_node(id);
+  return n.kind == ExprKind::Flonum ? n.d : to_double(expr_number_value(id));
+}
+
+Code literal(double d) {
+  std::string s = c_double_literal(d);
+  return {s, s[0] == '-' ? kUnary : kAtom};
+}
+
+// (expt b n) with n an exact integer that fits in int64.
+bool integer_power(ExprId id, int64_t *n) {
+  return expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), n);
+}
+
+// A number < 0, or a product whose leading coefficient is: such a term
+// is written subtracted.
+bool negative_term(ExprId id) {
+  if (expr_is_number(id)) return number_value(id) < 0;
+  if (!expr_is_apply(id, Op::Mul)) return false;
+  ExprId c = expr_arg(id, 0);
+  return expr_is_number(c) && number_value(c) < 0;
+}
+
+class Emitter {
+public:
+  explicit Emitter(const Trace &t) : t_(t) {
+    for (size_t i = 0; i < t.inputs.size(); ++i)
+      input_[t.inputs[i]] = i;
+    collect();
+    plan();
+  }
+
+  std::string function(const std::string &c_name, bool is_static) {
+    for (ExprId id : nodes_)
+      if (wants_name_.count(id) && !name_.count(id)) emit_named(id);
+    for (size_t j = 0; j < t_.outputs.size(); ++j) {
+      Code c = ref(t_.outputs[j]);
+      body_ += "  out[" + std::to_string(j) + "] = " + c.text + ";\n";
+    }
+    std::string f = is_static ? "static " : "";
+    f += "void " + c_name + "(const double *in, double *out, const double *p) {\n";
+    if (!uses_in_) f += "  (void)in;\n";
+    if (t_.outputs.empty()) f += "  (void)out;\n";
+    f += "  (void)p;\n";
+    f += body_;
+    f += "}\n";
+    return f;
+  }
+
+private:
+  // The nodes reachable from the outputs, in increasing id order, and how
+  // many times each is used (as an argument of a reachable node or as an
+  // output).
+  void collect() {
+    std::unordered_set<ExprId> seen;
+    std::vector<ExprId> stack(t_.outputs.begin(), t_.outputs.end());
+    while (!stack.empty()) {
+      ExprId id = stack.back();
+      stack.pop_back();
+      if (!seen.insert(id).second) continue;
+      nodes_.push_back(id);
+      if (expr_kind(id) != ExprKind::Apply) continue;
+      const ExprId *args = expr_args(id);
+      stack.insert(stack.end(), args, args + expr_node(id).nargs);
+    }
+    std::sort(nodes_.begin(), nodes_.end());
+    for (ExprId id : nodes_) {
+      if (expr_kind(id) != ExprKind::Apply) continue;
+      const ExprId *args = expr_args(id);
+      for (uint32_t i = 0; i < expr_node(id).nargs; ++i)
+        ++uses_[args[i]];
+    }
+    for (ExprId id : t_.outputs)
+      ++uses_[id];
+  }
+
+  void want_operand(ExprId id) {
+    if (expr_kind(id) == ExprKind::Apply) wants_name_.insert(id);
+  }
+
+  // Decide which nodes get names: shared ones, power bases, sincos pairs.
+  void plan() {
+    std::unordered_map<ExprId, ExprId> sin_of, cos_of; // argument -> node
+    for (ExprId id : nodes_) {
+      if (expr_kind(id) != ExprKind::Apply) continue;
+      if (uses_[id] >= 2) wants_name_.insert(id);
+      int64_t n;
+      if (integer_power(id, &n) && (n >= 2 || n <= -2)) want_operand(expr_arg(id, 0));
+      if (expr_is_apply(id, Op::Sin)) sin_of[expr_arg(id, 0)] = id;
+      if (expr_is_apply(id, Op::Cos)) cos_of[expr_arg(id, 0)] = id;
+    }
+    for (auto [arg, s] : sin_of) {
+      auto c = cos_of.find(arg);
+      if (c == cos_of.end()) continue;
+      partner_[s] = c->second;
+      partner_[c->second] = s;
+      wants_name_.insert(s);
+      wants_name_.insert(c->second);
+      want_operand(arg);
+    }
+  }
+
+  std::string temp() { return "t" + std::to_string(ntemps_++); }
+  static bool is_temporary(const std::string &s) {
+    return s.size() > 1 && s[0] == 't' && s.find_first_not_of("0123456789", 1) == std::string::npos;
+  }
+
+  // Give id a name, emitting the statement that computes it. Every node it
+  // uses that has a name already has one (smaller ids were handled first).
+  void emit_named(ExprId id) {
+    auto p = partner_.find(id);
+    if (p != partner_.end()) {
+      ExprId s = expr_is_apply(id, Op::Sin) ? id : p->second;
+      ExprId c = p->second == s ? id : p->second;
+      std::string ts = temp(), tc = temp();
+      body_ += "  double " + ts + ", " + tc + ";\n";
+      body_ += "  sincos(" + operand(expr_arg(s, 0)) + ", &" + ts + ", &" + tc + ");\n";
+      name_[s] = ts;
+      name_[c] = tc;
+      return;
+    }
+    Code c = inline_form(id); // may emit temporaries of its own first
+    if (is_temporary(c.text)) {
+      name_[id] = c.text; // a power by repeated squaring can end in a temporary
+      return;
+    }
+    std::string t = temp();
+    body_ += "  const double " + t + " = " + c.text + ";\n";
+    name_[id] = t;
+    int64_t n;
+    if (integer_power(id, &n) && n >= 2) powers_[{expr_arg(id, 0), static_cast<uint64_t>(n)}] = t;
+  }
+
+  // The node as it appears in an expression of its user.
+  Code ref(ExprId id) {
+    auto n = name_.find(id);
+    if (n != name_.end()) return {n->second, kAtom};
+    const ExprNode &node = expr_node(id);
+    switch (node.kind) {
+    case ExprKind::Rational:
+    case ExprKind::Flonum: return literal(number_value(id));
+    case ExprKind::Symbol: {
+      auto in = input_.find(node.sym);
+      SICM_ASSERT(in != input_.end()); // trace_procedure checked the symbols
+      uses_in_ = true;
+      return {"in[" + std::to_string(in->second) + "]", kAtom};
+    }
+    case ExprKind::Apply: return inline_form(id);
+    case ExprKind::Call: break; // trace_procedure refuses Calls
+    }
+    internal_failure(__FILE__, __LINE__, "a Call node reached the C emitter");
+  }
+
+  // A node that must be a simple operand (a name, an input or a literal).
+  std::string operand(ExprId id) { return wrap(ref(id), kAtom); }
+
+  // a0 * a1 * ...: the grouping of a left fold.
+  Code product(const std::vector<Code> &factors) {
+    if (factors.size() == 1) return factors[0];
+    std::string s = wrap(factors[0], kMul);
+    for (size_t i = 1; i < factors.size(); ++i)
+      s += " * " + wrap(factors[i], kUnary);
+    return {s, kMul};
+  }
+
+  // -term for a term with negative_term(term).
+  Code negated(ExprId id) {
+    if (expr_is_number(id)) return literal(-number_value(id));
+    std::vector<ExprId> args = expr_arg_vector(id);
+    double c = number_value(args[0]);
+    std::vector<Code> factors;
+    if (c != -1.0) factors.push_back(literal(-c));
+    for (size_t i = 1; i < args.size(); ++i)
+      factors.push_back(ref(args[i]));
+    return product(factors);
+  }
+
+  Code sum(const std::vector<ExprId> &args) {
+    std::string s = wrap(ref(args[0]), kAdd);
+    for (size_t i = 1; i < args.size(); ++i) {
+      if (!name_.count(args[i]) && negative_term(args[i]))
+        s += " - " + wrap(negated(args[i]), kMul);
+      else
+        s += " + " + wrap(ref(args[i]), kMul);
+    }
+    return {s, kAdd};
+  }
+
+  Code mul(const std::vector<ExprId> &args) {
+    if (expr_is_number(args[0]) && number_value(args[0]) == -1.0 && args.size() > 1) {
+      std::vector<Code> rest;
+      for (size_t i = 1; i < args.size(); ++i)
+        rest.push_back(ref(args[i]));
+      return {"-" + wrap(product(rest), kAtom), kUnary};
+    }
+    std::vector<Code> factors;
+    for (ExprId a : args)
+      factors.push_back(ref(a));
+    return product(factors);
+  }
+
+  // base^m for m >= 1: small powers as products, larger ones by repeated
+  // squaring into temporaries, reusing every square of this base computed
+  // so far (and named powers); the product of the squares that the binary
+  // digits of m select.
+  Code power(ExprId base, uint64_t m) {
+    if (m == 1) return ref(base);
+    auto hit = powers_.find({base, m});
+    if (hit != powers_.end()) return {hit->second, kAtom};
+    std::string b = operand(base);
+    if (m == 2) return {b + " * " + b, kMul};
+    if (m == 3) {
+      auto square = powers_.find({base, 2});
+      if (square != powers_.end()) return {square->second + " * " + b, kMul};
+      return {b + " * " + b + " * " + b, kMul};
+    }
+    std::vector<Code> parts;
+    std::string square = b;
+    for (uint64_t e = 1;;) {
+      if (m & 1) parts.push_back({square, kAtom});
+      m >>= 1;
+      if (m == 0) break;
+      e *= 2;
+      auto s = powers_.find({base, e});
+      if (s == powers_.end()) {
+        std::string t = temp();
+        body_ += "  const double " + t + " = " + square + " * " + square + ";\n";
+        s = powers_.emplace(std::make_pair(base, e), t).first;
+      }
+      square = s->second;
+    }
+    return product(parts);
+  }
+
+  Code call(const char *fn, const std::vector<ExprId> &args) {
+    std::string s = std::string(fn) + "(";
+    for (size_t i = 0; i < args.size(); ++i)
+      s += (i ? ", " : "") + ref(args[i]).text;
+    return {s + ")", kAtom};
+  }
+
+  // An operation node written out in full (its arguments by ref).
+  Code inline_form(ExprId id) {
+    Op op = expr_node(id).op;
+    std::vector<ExprId> args = expr_arg_vector(id);
+    switch (op) {
+    case Op::Add: return sum(args);
+    case Op::Mul: return mul(args);
+    case Op::Sub: {
+      if (args.size() == 1) return {"-" + wrap(ref(args[0]), kAtom), kUnary};
+      std::string s = wrap(ref(args[0]), kAdd);
+      for (size_t i = 1; i < args.size(); ++i)
+        s += " - " + wrap(ref(args[i]), kMul);
+      return {s, kAdd};
+    }
+    case Op::Div: {
+      if (args.size() == 1) return {"1.0 / " + wrap(ref(args[0]), kUnary), kMul};
+      std::string s = wrap(ref(args[0]), kMul);
+      for (size_t i = 1; i < args.size(); ++i)
+        s += " / " + wrap(ref(args[i]), kUnary);
+      return {s, kMul};
+    }
+    case Op::Expt: {
+      int64_t n;
+      if (!integer_power(id, &n)) return call("pow", args);
+      if (n == 0) return {"1.0", kAtom};
+      uint64_t m = n < 0 ? 0 - static_cast<uint64_t>(n) : static_cast<uint64_t>(n);
+      Code p = power(args[0], m);
+      if (n > 0) return p;
+      return {"1.0 / " + wrap(p, kAtom), kMul};
+    }
+    case Op::Atan: return call(args.size() == 2 ? "atan2" : "atan", args);
+    case Op::Sqrt:
+    case Op::Exp:
+    case Op::Log:
+    case Op::Sin:
+    case Op::Cos:
+    case Op::Tan:
+    case Op::Asin:
+    case Op::Acos:
+    case Op::Sinh:
+    case Op::Cosh:
+    case Op::Abs: SICM_ASSERT(args.size() == 1); return call(op_info(op).c_name, args);
+    }
+    internal_failure(__FILE__, __LINE__, "an operator without a C form");
+  }
+
+  const Trace &t_;
+  std::unordered_map<Symbol *, size_t> input_;
+  std::vector<ExprId> nodes_; // reachable from the outputs, increasing ids
+  std::unordered_map<ExprId, uint32_t> uses_;
+  std::unordered_set<ExprId> wants_name_;
+  std::unordered_map<ExprId, ExprId> partner_; // sin node <-> cos node of one argument
+  std::unordered_map<ExprId, std::string> name_;
+  std::map<std::pair<ExprId, uint64_t>, std::string> powers_; // (base, m) -> a name of base^m
+  std::string body_;
+  size_t ntemps_ = 0;
+  bool uses_in_ = false;
+};
+
+} // namespace
+
+std::string c_sanitize(std::string_view s, size_t max_len) {
+  std::string out;
+  for (char ch : s.substr(0, max_len)) {
+    bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9');
+    out += ok ? ch : '_';
+  }
+  return out.empty() ? "anonymous" : out;
+}
+
+std::string c_double_literal(double d) {
+  if (std::isnan(d)) return "NAN";
+  if (std::isinf(d)) return d > 0 ? "INFINITY" : "-INFINITY";
+  char buf[SICM_DOUBLE_BUFSIZE];
+  sicm_format_double(buf, d);
+  std::string s = buf; // MIT's shortest form: ".5", "1.", "-1.5e-14", "1e21"
+  size_t lead = s[0] == '-' ? 1 : 0;
+  if (s[lead] == '.') s.insert(lead, "0");
+  size_t mantissa_end = s.find('e');
+  if (mantissa_end == std::string::npos) mantissa_end = s.size();
+  if (s[mantissa_end - 1] == '.') s.insert(mantissa_end, "0");
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string emit_kernel_function(const Trace &t, const std::string &c_name, bool is_static) {
+  return Emitter(t).function(c_name, is_static);
+}
+
+std::string emit_kernel_unit(const Trace &t, const std::string &c_name,
+                             std::string_view source_name) {
+  std::string s = "/* sicm kernel " + c_sanitize(source_name, 64) + ": " +
+                  std::to_string(t.inputs.size()) + " inputs, " +
+                  std::to_string(t.outputs.size()) +
+                  " outputs. Generated by the sicm compiler; do not edit. */\n";
+  s += "#define _GNU_SOURCE\n#include <math.h>\n\n";
+  s += "void " + c_name + "(const double *in, double *out, const double *p);\n\n";
+  s += emit_kernel_function(t, c_name, false);
+  return s;
+}
+
+} // namespace sicm

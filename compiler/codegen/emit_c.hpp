@@ -1,0 +1,35 @@
+// The C emitter: a traced kernel as one C11 function with the kernel ABI.
+//
+// Requires: a Trace (codegen/trace.hpp): outputs over the inputs x_i with only
+// numbers, input symbols and ops.def applications. Produces: C text that
+// compiles warning-free with -std=c11 -Wall -Wextra, and contains no user
+// text except names sanitized to [A-Za-z0-9_].
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "codegen/trace.hpp"
+
+namespace sicm {
+
+// The function `c_name` (not static unless asked), without includes:
+//   void c_name(const double *in, double *out, const double *p) { ... }
+// in and out must not overlap. Needs <math.h> with _GNU_SOURCE (for sincos).
+std::string emit_kernel_function(const Trace &t, const std::string &c_name, bool is_static);
+
+// A whole translation unit for the C compiler: a comment naming the source
+// procedure (sanitized), the feature macro and includes, a prototype and the
+// function.
+std::string emit_kernel_unit(const Trace &t, const std::string &c_name,
+                             std::string_view source_name);
+
+// s with every byte outside [A-Za-z0-9_] replaced by '_', cut to max_len
+// bytes; "anonymous" if s is empty.
+std::string c_sanitize(std::string_view s, size_t max_len = 48);
+
+// A finite or infinite double as a C expression that denotes exactly it:
+// "0.5", "1.0", "-2.5e-10", "INFINITY", "NAN".
+std::string c_double_literal(double d);
+
+} // namespace sicm

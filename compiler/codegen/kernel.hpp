@@ -1,0 +1,83 @@
+// Native kernels: procedures on numbers and structures of numbers, compiled to C and loaded.
+//
+// A kernel is what a numerical primitive runs in its inner loop: a state
+// derivative, a map, an integrand. compile_kernel turns a Scheme procedure into
+// one in three passes, each in its own file:
+//
+//   trace.cpp   apply the procedure to fresh symbols shaped like sample
+//               arguments, simplify each scalar leaf of the result
+//               (requires: the procedure computes its result by generic
+//               arithmetic alone; produces: a Trace, the outputs as
+//               expressions over the input symbols)
+//   emit_c.cpp  the Trace as one C11 function with the kernel ABI, after CSE,
+//               powers as products and sin/cos pairs as sincos
+//   jit.cpp     the C compiled by the system compiler into a shared object,
+//               cached by content hash, and loaded with dlopen
+//
+// Then the kernel is checked once against the interpreter at the sample
+// arguments (see compile_kernel). compile_kernel and the helpers to call a
+// kernel live in trace.cpp, beside the first pass. A procedure that cannot be traced (it
+// branches on its arguments, returns a non-number, calls a literal function)
+// or a C compiler that is missing or fails gives nullptr and a reason: the
+// caller interprets the procedure instead.
+//
+// The ABI of every kernel: void NAME(const double *in, double *out, const
+// double *p), in[] the arguments' scalar leaves in order (depth first, left to
+// right, argument after argument), out[] the result's leaves in the same
+// order, p reserved for parameters that stay dynamic (unused for now: callers
+// pass null).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "eval/value.hpp"
+
+namespace sicm {
+
+using KernelFn = void (*)(const double *in, double *out, const double *p);
+
+// Allocated with gc_new (it holds Values); its strings are freed by a
+// finalizer when it is collected. The loaded code is never unloaded.
+struct Kernel {
+  KernelFn fn = nullptr;
+  size_t nin = 0, nout = 0;
+  Value arg_shapes;   // the sample arguments as given (a list): their shapes
+  Value result_shape; // a structure of the result's shape, or a number for a scalar result
+  std::string name;     // the procedure's name as the user wrote it (for printing)
+  std::string c_name;   // the C function's name (generated, [A-Za-z0-9_] only)
+  std::string c_source; // the whole translation unit given to the C compiler
+  std::string so_path;  // the shared object in the cache
+};
+
+// Compile `proc` for arguments shaped like `sample_args` (a Scheme list with
+// one value per argument: a number or a nested up/down structure of numbers).
+// `name` names the kernel in messages and, sanitized, in the C source (null:
+// the procedure's own name, or "anonymous"). On failure returns nullptr and,
+// if why_not is not null, stores a one-line reason there; errors the
+// procedure raises while it is traced are caught and become the reason.
+// The procedure runs twice: once on symbols, once at the sample arguments to
+// check the kernel, so its side effects happen then, not when the kernel runs.
+Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not);
+
+// Run the kernel: in has k->nin doubles, out room for k->nout.
+void kernel_call(const Kernel *k, const double *in, double *out);
+
+// The result as a Scheme value: a flonum, or a structure of k's result shape
+// whose leaves are out[0 .. k->nout).
+Value kernel_result_value(const Kernel *k, const double *out);
+
+// Append the scalar leaves of v (a number or a nested structure of numbers) to
+// out as doubles. Raises MIT's wrong-type error (naming `who`) on anything else.
+void flatten_value(Value v, std::vector<double> &out, const char *who = "kernel");
+
+// Does v have the shape of `shape` (same nesting of up and down structures of
+// the same lengths, numbers at the leaves)?
+bool value_has_shape(Value v, Value shape);
+
+// (compile-procedure proc sample ...), (kernel? x), (kernel-c-source k).
+// Called by init_interpreter.
+void install_kernel_primitives();
+
+} // namespace sicm

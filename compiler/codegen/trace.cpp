@@ -1,0 +1,292 @@
+// Tracing a procedure into expressions over fresh input symbols (see trace.hpp).
+//
+// The procedure runs once, in the ordinary evaluator, on arguments whose
+// scalar leaves are uninterned symbols: generic arithmetic then builds
+// expressions instead of numbers. Whatever the procedure does with the
+// numbers it closes over is done at trace time, so known parameters fold into
+// constants and terms multiplied by an exact zero vanish. What comes back is
+// checked leaf by leaf: a leaf must simplify to a number or to an expression
+// whose only symbols are the inputs and whose only operations are those of
+// ops.def (the C emitter knows no others).
+#include "codegen/trace.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+#include "algebra/structure.hpp"
+#include "codegen/emit_c.hpp"
+#include "codegen/jit.hpp"
+#include "codegen/kernel.hpp"
+#include "eval/primitive.hpp"
+#include "algebra/symbolic.hpp"
+#include "eval/number.hpp"
+#include "eval/procedure.hpp"
+#include "print/printer.hpp"
+
+namespace sicm {
+
+// compile_kernel runs the kernel once at the sample arguments and requires
+// each output to agree with the interpreter's to this relative tolerance
+// (relative to max(1, |values|)): far above the rounding differences of a
+// simplified expression, far below what a branch traced the wrong way gives.
+constexpr double kSampleTolerance = 1e-9;
+
+namespace {
+
+const char *ordinal(size_t i) {
+  static const char *const names[] = {"first", "second", "third", "fourth", "fifth",
+                                      "sixth", "seventh", "eighth", "ninth", "tenth"};
+  return i < 10 ? names[i] : "a later";
+}
+
+// Messages quote user values; keep them to one readable line.
+std::string brief(Value v) {
+  std::string s = write_string(v);
+  constexpr size_t kMax = 80;
+  if (s.size() > kMax) s = s.substr(0, kMax) + "...";
+  return s;
+}
+
+// The expression node of a simplified scalar leaf, or kNoExpr if the leaf is
+// not a number, a symbol or an expression.
+ExprId leaf_expr(Value leaf) {
+  if (is_number(leaf)) return expr_from_number(leaf);
+  if (leaf.is(Tag::Symbol)) return expr_symbol(leaf.symbol());
+  if (leaf.is(Tag::Expr)) return static_cast<ExprId>(leaf.i);
+  return kNoExpr;
+}
+
+// Check that every node under `root` is a number, an input symbol or an
+// Apply; `seen` is shared across the leaves so each node is visited once.
+bool check_expression(ExprId root, const std::unordered_set<Symbol *> &inputs,
+                      std::unordered_set<ExprId> &seen, std::string *why_not) {
+  std::vector<ExprId> stack{root};
+  while (!stack.empty()) {
+    ExprId id = stack.back();
+    stack.pop_back();
+    if (!seen.insert(id).second) continue;
+    const ExprNode &n = expr_node(id);
+    switch (n.kind) {
+    case ExprKind::Rational:
+    case ExprKind::Flonum: break;
+    case ExprKind::Symbol:
+      if (!inputs.count(n.sym)) {
+        *why_not = "the result depends on the symbol " + n.sym->name +
+                   ", which is not an argument (give it a numeric value)";
+        return false;
+      }
+      break;
+    case ExprKind::Call:
+      *why_not = "the result applies the unknown function " + expr_debug_string(n.head) +
+                 " (a literal function cannot be compiled)";
+      return false;
+    case ExprKind::Apply: {
+      const ExprId *args = expr_args(id);
+      stack.insert(stack.end(), args, args + n.nargs);
+      break;
+    }
+    }
+  }
+  return true;
+}
+
+// Turn the result's leaves into checked, simplified expressions.
+bool collect_outputs(Value result, Trace *t, std::string *why_not) {
+  if (is_structure(result)) {
+    gcvec<Value> leaves;
+    structure_leaves(result, leaves);
+    gcvec<Value> zeros(leaves.size(), Value::fixnum(0));
+    t->result_shape = shape_from_leaves(result, false, zeros.data());
+    std::unordered_set<Symbol *> inputs(t->inputs.begin(), t->inputs.end());
+    std::unordered_set<ExprId> seen;
+    for (Value leaf : leaves) {
+      ExprId id = leaf_expr(simplify_value(leaf));
+      if (id == kNoExpr) {
+        *why_not = "the result has a component that is not a number: " + brief(leaf);
+        return false;
+      }
+      if (!check_expression(id, inputs, seen, why_not)) return false;
+      t->outputs.push_back(id);
+    }
+    return true;
+  }
+  ExprId id = leaf_expr(simplify_value(result));
+  if (id == kNoExpr) {
+    *why_not = "the result is not a number or a structure of numbers: " + brief(result);
+    return false;
+  }
+  std::unordered_set<Symbol *> inputs(t->inputs.begin(), t->inputs.end());
+  std::unordered_set<ExprId> seen;
+  if (!check_expression(id, inputs, seen, why_not)) return false;
+  t->result_shape = Value::fixnum(0);
+  t->outputs.push_back(id);
+  return true;
+}
+
+} // namespace
+
+bool is_numeric_shape(Value v) {
+  if (is_number(v)) return true;
+  if (!is_structure(v)) return false;
+  Structure *s = as_structure(v);
+  for (size_t i = 0; i < s->len; ++i)
+    if (!is_numeric_shape(s->items[i])) return false;
+  return true;
+}
+
+bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_not) {
+  if (!is_procedure(proc)) {
+    *why_not = "the object " + brief(proc) + " is not a procedure";
+    return false;
+  }
+  if (list_length(sample_args) < 0) {
+    *why_not = "the sample arguments are not a list";
+    return false;
+  }
+  gcvec<Value> samples = list_to_vector(sample_args);
+  gcvec<Value> args;
+  gcvec<Value> symbols;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (!is_numeric_shape(samples[i])) {
+      *why_not = std::string("the ") + ordinal(i) + " sample argument, " + brief(samples[i]) +
+                 ", is not a number or a structure of numbers";
+      return false;
+    }
+    size_t first = symbols.size(), n = structure_dimension(samples[i]);
+    for (size_t k = 0; k < n; ++k) {
+      Value x = make_uninterned_symbol("x" + std::to_string(symbols.size()));
+      symbols.push_back(x);
+      t->inputs.push_back(x.symbol());
+    }
+    args.push_back(is_structure(samples[i])
+                       ? shape_from_leaves(samples[i], false, symbols.data() + first)
+                       : symbols[first]);
+  }
+  try {
+    Value result = apply_procedure(proc, args.data(), static_cast<int>(args.size()));
+    return collect_outputs(result, t, why_not);
+  } catch (const Error &e) {
+    *why_not = std::string("applying it to symbolic arguments failed: ") + e.what();
+    return false;
+  }
+}
+
+// ---- the pipeline: trace, emit, compile, check -------------------------------------
+
+namespace {
+
+void finalize_kernel(void *obj, void *) {
+  static_cast<Kernel *>(obj)->~Kernel();
+}
+
+std::string procedure_name(Value proc) {
+  if (proc.is(Tag::Closure) && proc.as<Closure>()->lambda->name)
+    return proc.as<Closure>()->lambda->name->name;
+  if (proc.is(Tag::Primitive)) return proc.as<Primitive>()->name;
+  return "anonymous";
+}
+
+bool close_enough(double a, double b) {
+  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b);
+  if (a == b) return true;
+  return std::fabs(a - b) <= kSampleTolerance * std::max({1.0, std::fabs(a), std::fabs(b)});
+}
+
+std::string show_double(double d) {
+  return write_string(Value::flonum(d));
+}
+
+// Run the kernel and the interpreter at the sample arguments and compare.
+// A procedure that raises there (a division by zero at 0.) is not compared.
+bool agrees_at_sample(const Kernel *k, Value proc, Value sample_args, std::string *why_not) {
+  gcvec<Value> samples = list_to_vector(sample_args);
+  Value expected;
+  try {
+    expected = apply_procedure(proc, samples.data(), static_cast<int>(samples.size()));
+  } catch (const Error &) {
+    return true;
+  }
+  if (!value_has_shape(expected, k->result_shape)) {
+    *why_not = "at the sample arguments the procedure returns " + brief(expected) +
+               ", which is not shaped like the traced result (does it branch on its arguments?)";
+    return false;
+  }
+  std::vector<double> in, want, got(k->nout);
+  for (Value s : samples)
+    flatten_value(s, in);
+  flatten_value(expected, want);
+  kernel_call(k, in.data(), got.data());
+  for (size_t j = 0; j < k->nout; ++j) {
+    if (close_enough(got[j], want[j])) continue;
+    *why_not = "at the sample arguments the compiled kernel gives " + show_double(got[j]) +
+               " for output " + std::to_string(j) + " but the procedure gives " +
+               show_double(want[j]) + " (does it branch on = or zero? of an argument?)";
+    return false;
+  }
+  return true;
+}
+
+} // namespace
+
+Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not) {
+  std::string ignored;
+  if (!why_not) why_not = &ignored;
+  std::string kname = name ? name : procedure_name(proc);
+  Trace t;
+  if (!trace_procedure(proc, sample_args, &t, why_not)) return nullptr;
+  std::string c_name = "sicm_kernel_" + c_sanitize(kname);
+  std::string source = emit_kernel_unit(t, c_name, kname);
+  std::string so;
+  void *fn = jit_load(source, c_name, &so, why_not);
+  if (!fn) return nullptr;
+  Kernel *k = gc_new<Kernel>();
+  // ignore_self: a std::string member may point into the object (its short-string buffer).
+  GC_register_finalizer_ignore_self(k, finalize_kernel, nullptr, nullptr, nullptr);
+  k->fn = reinterpret_cast<KernelFn>(fn);
+  k->nin = t.inputs.size();
+  k->nout = t.outputs.size();
+  k->arg_shapes = sample_args;
+  k->result_shape = t.result_shape;
+  k->name = kname;
+  k->c_name = c_name;
+  k->c_source = std::move(source);
+  k->so_path = so;
+  if (!agrees_at_sample(k, proc, sample_args, why_not)) return nullptr;
+  return k;
+}
+
+void kernel_call(const Kernel *k, const double *in, double *out) {
+  k->fn(in, out, nullptr);
+}
+
+Value kernel_result_value(const Kernel *k, const double *out) {
+  if (!is_structure(k->result_shape)) return Value::flonum(out[0]);
+  gcvec<Value> leaves(k->nout);
+  for (size_t j = 0; j < k->nout; ++j)
+    leaves[j] = Value::flonum(out[j]);
+  return shape_from_leaves(k->result_shape, false, leaves.data());
+}
+
+void flatten_value(Value v, std::vector<double> &out, const char *who) {
+  if (is_number(v)) {
+    out.push_back(to_double(v));
+    return;
+  }
+  if (!is_structure(v)) wrong_type(v, 1, who);
+  Structure *s = as_structure(v);
+  for (size_t i = 0; i < s->len; ++i)
+    flatten_value(s->items[i], out, who);
+}
+
+bool value_has_shape(Value v, Value shape) {
+  if (!is_structure(shape)) return is_number(v);
+  if (!is_structure(v)) return false;
+  Structure *a = as_structure(v), *b = as_structure(shape);
+  if (a->up != b->up || a->len != b->len) return false;
+  for (size_t i = 0; i < a->len; ++i)
+    if (!value_has_shape(a->items[i], b->items[i])) return false;
+  return true;
+}
+
+} // namespace sicm

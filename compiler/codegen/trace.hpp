@@ -1,0 +1,39 @@
+// Tracing: a procedure applied to symbols shaped like its arguments, giving its result as expressions.
+//
+// Requires: a procedure that computes its result from its arguments by generic
+// arithmetic (numbers it captures fold into constants). Produces: a Trace, one
+// simplified expression per scalar leaf of the result, over fresh uninterned
+// symbols x0, x1, ... that stand for the arguments' scalar leaves.
+//
+// Limits: a procedure that branches on an argument cannot be traced when the
+// test raises on a symbol (`<`, `positive?`), which is reported; but `=`,
+// `zero?` and `number?` answer #f for a symbol, so such a branch is traced as
+// if it were never taken. compile_kernel catches that case at the sample
+// point only, by comparing the kernel with the interpreter there.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "algebra/expr.hpp"
+#include "eval/value.hpp"
+
+namespace sicm {
+
+// Lives on the stack (it holds a Value and a gcvec that the collector must see).
+struct Trace {
+  gcvec<Symbol *> inputs;      // x_i stands for in[i]
+  std::vector<ExprId> outputs; // out[j]: simplified, only numbers, x_i and ops.def applications
+  Value result_shape;          // the result with exact zeros at its leaves (0 for a scalar)
+};
+
+// Trace `proc` on arguments shaped like the elements of the list sample_args
+// (each a number or a nested up/down structure of numbers). Returns false and
+// a one-line reason in *why_not when the procedure cannot be traced. Errors
+// the procedure raises on symbolic arguments are caught and become the reason.
+bool trace_procedure(Value proc, Value sample_args, Trace *out, std::string *why_not);
+
+// True if v is a number or a nested up/down structure whose leaves are numbers.
+bool is_numeric_shape(Value v);
+
+} // namespace sicm

@@ -1,0 +1,11 @@
+// Numerical primitives of the interpreter: quadrature, minimization, root
+// finding and ODE integration (definite-integral, minimize, nelder-mead,
+// multidimensional-minimize, find-root, bisect, state-advancer, evolve), over
+// the runtime's numerical modules (runtime/include/sicm/*.h).
+#pragma once
+
+namespace sicm {
+
+void install_numerics_primitives();
+
+} // namespace sicm
