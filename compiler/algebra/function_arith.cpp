@@ -70,7 +70,9 @@ Value call_compose(NativeProc *self, Value *args, int nargs) {
     if (nargs != 1) native_arity_error(self, nargs, 1);
     return args[0];
   }
-  Value v = operand_value(self->items[self->nitems - 1], args, nargs);
+  // Applied, never taken as a constant: a structure of functions composes too.
+  gcvec<Value> copy(args, args + nargs);
+  Value v = apply_procedure(self->items[self->nitems - 1], copy.data(), nargs);
   for (size_t i = self->nitems - 1; i-- > 0;)
     v = apply_procedure(self->items[i], &v, 1);
   return v;

@@ -164,7 +164,7 @@ Value P_series_sum(Value *a, int) {
   arg_series(a, 0, "series:sum");
   size_t n = arg_index(a, 1, "series:sum");
   Value sum = Value::fixnum(0);
-  for (size_t k = 0; k < n; ++k)
+  for (size_t k = 0; k <= n; ++k)
     sum = g_add(sum, series_term(a[0], k));
   return sum;
 }
