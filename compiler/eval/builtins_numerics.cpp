@@ -7,9 +7,11 @@
 // vector becomes a structure of the initial state's shape), the procedure's
 // result is converted back to doubles. Everything the runtime sees is a
 // (C function, params) pair built in one place per kind of problem
-// (ScalarCallback, VectorCallback, OdeCallback below), so that a compiled
-// kernel, a C function computing the same values, can later be handed to the
-// same runtime calls instead of the callback.
+// (ScalarCallback, VectorCallback, OdeCallback below). When the procedure is
+// a native kernel (compile-procedure, codegen/kernel.hpp) of the right
+// shape, the same callbacks run the kernel on the doubles directly, without
+// making Scheme values; a pass that compiles system derivatives and
+// integrands automatically only has to hand a kernel in.
 //
 // Errors. A Scheme error (or a continuation escape) inside a callback must
 // not unwind through the runtime's C frames: the callback catches it, tells
@@ -26,6 +28,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <memory>
 #include <string>
@@ -33,6 +36,7 @@
 
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
+#include "codegen/kernel.hpp"
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
@@ -124,6 +128,21 @@ std::string number_text(double x) {
   return number_to_string(Value::flonum(x));
 }
 
+// A native kernel made by compile-procedure, or null.
+const Kernel *kernel_of(Value f) {
+  if (!f.is(Tag::Opaque) || std::strcmp(f.as<Opaque>()->kind->name, "kernel") != 0) return nullptr;
+  return static_cast<const Kernel *>(f.as<Opaque>()->obj);
+}
+
+// f as a kernel from one real to one real, or null.
+const Kernel *scalar_kernel_of(Value f) {
+  const Kernel *k = kernel_of(f);
+  if (!k || list_length(k->arg_shapes) != 1 || is_structure(car(k->arg_shapes)) || k->nin != 1 ||
+      k->nout != 1)
+    return nullptr;
+  return k;
+}
+
 // ---- callbacks ----------------------------------------------------------------
 
 // What every callback shares: where the primitive was called (for errors
@@ -145,7 +164,19 @@ struct Callback {
 // to find a root of).
 struct ScalarCallback : Callback {
   Value f;
-  ScalarCallback(SrcLoc l, const char *w, Value fn) : Callback(l, w), f(fn) {}
+  const Kernel *kernel;   // f itself when it is a kernel of one real
+  bool nonfinite = false; // f returned a NaN or an infinity, first at bad_x
+  double bad_x = 0, bad_value = 0;
+  ScalarCallback(SrcLoc l, const char *w, Value fn)
+      : Callback(l, w), f(fn), kernel(scalar_kernel_of(fn)) {}
+  // The reason for a failure of the runtime: a non-finite value in Scheme's
+  // words if there was one, else the runtime's message.
+  std::string reason() const {
+    if (nonfinite)
+      return "the function is " + number_text(bad_value) + " at " + number_text(bad_x) +
+             ", not a finite number";
+    return reason_of(g_runtime_message);
+  }
 };
 
 // The procedure's value as a double; a non-number is an error.
@@ -160,9 +191,20 @@ double call_scalar(double x, void *data) {
   auto *cb = static_cast<ScalarCallback *>(data);
   if (cb->error) return NAN;
   try {
-    Value arg = Value::flonum(x);
-    Value r = apply_procedure(cb->f, &arg, 1);
-    return real_result(*cb, r, number_text(x));
+    double v;
+    if (cb->kernel) {
+      kernel_call(cb->kernel, &x, &v);
+    } else {
+      Value arg = Value::flonum(x);
+      Value r = apply_procedure(cb->f, &arg, 1);
+      v = real_result(*cb, r, number_text(x));
+    }
+    if (!std::isfinite(v) && !cb->nonfinite) {
+      cb->nonfinite = true;
+      cb->bad_x = x;
+      cb->bad_value = v;
+    }
+    return v;
   } catch (...) {
     cb->error = std::current_exception();
     return NAN;
@@ -337,6 +379,7 @@ private:
 struct OdeCallback : Callback {
   Value sysder;
   const StateShape *shape;
+  const Kernel *kernel = nullptr; // sysder itself when it is a kernel on the state's shape
   // Every derivative computed so far had exactly 1 as its time component:
   // then the time component of the solution is exactly the integrator's
   // time, and results carry that instead of the sum of the steps.
@@ -348,6 +391,11 @@ struct OdeCallback : Callback {
 int call_sysder(double, const double *y, double *dydt, void *data) {
   auto *cb = static_cast<OdeCallback *>(data);
   if (cb->error) return 1;
+  if (cb->kernel) {
+    kernel_call(cb->kernel, y, dydt);
+    if (cb->shape->time_first() && dydt[0] != 1.0) cb->time_rate_one = false;
+    return 0;
+  }
   try {
     Value state = cb->shape->build(y);
     Value d = apply_procedure(cb->sysder, &state, 1);
@@ -418,6 +466,10 @@ struct OdeProblem {
     if (!shape.describe(state) || shape.dim() == 0) wrong_type(state, argpos, who);
     y.resize(shape.dim());
     shape.read(state, y.data());
+    const Kernel *k = kernel_of(sysder);
+    if (k && list_length(k->arg_shapes) == 1 && value_has_shape(state, car(k->arg_shapes)) &&
+        k->nin == shape.dim() && k->nout == shape.dim())
+      cb.kernel = k;
     t0 = shape.time_first() && std::isfinite(y[0]) ? y[0] : 0.0;
   }
 
@@ -567,7 +619,7 @@ Value P_definite_integral(Value *a, int n) {
     // the true one): rounding errors of the size of the integral of |f| times
     // the machine epsilon swamp it. Then the tolerance is taken relative to
     // the integral of |f| instead, and the integral is computed again.
-    std::string message = g_runtime_message;
+    std::string message = cb.reason();
     double magnitude = 0;
     int s2 = sicm_quad_integrate(call_scalar_abs, &cb, lo, hi, 1e-3, &magnitude);
     cb.rethrow_if_failed();
@@ -578,9 +630,9 @@ Value P_definite_integral(Value *a, int n) {
       cb.rethrow_if_failed();
       if (status == SICM_SUCCESS) return Value::flonum(result);
     }
-    numeric_error(loc, who, reason_of(message));
+    numeric_error(loc, who, message);
   }
-  if (status != SICM_SUCCESS) numeric_error(loc, who, reason_of(g_runtime_message));
+  if (status != SICM_SUCCESS) numeric_error(loc, who, cb.reason());
   return Value::flonum(result);
 }
 
@@ -602,7 +654,7 @@ Value minimize_with(const char *who, Value *a, int n) {
     RuntimeErrorScope scope;
     int status = sicm_min_brent(call_scalar, &cb, lo, hi, tol, &xmin, &fmin, &iterations);
     cb.rethrow_if_failed();
-    if (status != SICM_SUCCESS) numeric_error(loc, who, reason_of(g_runtime_message));
+    if (status != SICM_SUCCESS) numeric_error(loc, who, cb.reason());
   }
   return list({Value::flonum(xmin), Value::flonum(fmin), Value::fixnum(iterations)});
 }
@@ -717,12 +769,22 @@ Value P_find_root(Value *a, int n) {
     if (!(tol >= 0) || !std::isfinite(tol)) bad_range(a[3], 4, who);
   }
   if (lo > hi) std::swap(lo, hi);
+  if (lo == hi) bad_range(a[2], 3, who);
   ScalarCallback cb(loc, who, f);
+  double f_lo = call_scalar(lo, &cb), f_hi = call_scalar(hi, &cb);
+  cb.rethrow_if_failed();
+  if (f_lo == 0) return Value::flonum(lo);
+  if (f_hi == 0) return Value::flonum(hi);
+  if (std::isfinite(f_lo) && std::isfinite(f_hi) && (f_lo > 0) == (f_hi > 0))
+    numeric_error(loc, who,
+                  "the function is " + number_text(f_lo) + " at " + number_text(lo) + " and " +
+                      number_text(f_hi) + " at " + number_text(hi) +
+                      ": the interval does not bracket a root");
   double root = 0;
   RuntimeErrorScope scope;
   int status = sicm_root_brent(call_scalar, &cb, lo, hi, tol, &root);
   cb.rethrow_if_failed();
-  if (status != SICM_SUCCESS) numeric_error(loc, who, reason_of(g_runtime_message));
+  if (status != SICM_SUCCESS) numeric_error(loc, who, cb.reason());
   return Value::flonum(root);
 }
 
