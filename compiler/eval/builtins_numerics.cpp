@@ -28,6 +28,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <memory>
@@ -452,6 +453,43 @@ const sicm_ode_step_type *arg_integrator(Value *a, int n, int i, const char *who
   return T;
 }
 
+// ---- native system derivatives ----------------------------------------------------
+
+// System derivatives are compiled to native kernels automatically: traced,
+// emitted as C, compiled once and cached (codegen/). A procedure that cannot
+// be traced (it branches on the state, calls an unknown function) keeps
+// running interpreted. SICM_INTERPRET=1 in the environment turns this off.
+// Recent (procedure, shape) -> kernel pairs are remembered, because a
+// state advancer inside a map is called over and over with the same
+// procedure.
+struct CompiledSysder {
+  Value sysder;
+  Value state_shape;    // a sample state
+  const Kernel *kernel; // null: not traceable
+};
+gcvec<CompiledSysder> g_compiled; // static, hence a root for the collector
+constexpr size_t kCompiledMemo = 32;
+
+bool kernels_enabled() {
+  static const bool enabled = [] {
+    const char *e = std::getenv("SICM_INTERPRET");
+    return !(e && *e && std::strcmp(e, "0") != 0);
+  }();
+  return enabled;
+}
+
+const Kernel *auto_kernel(Value sysder, Value state, size_t dim) {
+  if (!kernels_enabled() || !is_procedure(sysder)) return nullptr;
+  for (const CompiledSysder &c : g_compiled)
+    if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape)) return c.kernel;
+  std::string why;
+  const Kernel *k = compile_kernel(sysder, list({state}), "system_derivative", &why);
+  if (k && (k->nin != dim || k->nout != dim)) k = nullptr;
+  if (g_compiled.size() >= kCompiledMemo) g_compiled.erase(g_compiled.begin());
+  g_compiled.push_back(CompiledSysder{sysder, state, k});
+  return k;
+}
+
 // ---- one integration problem ----------------------------------------------------
 
 // A state, flattened, with its shape and the system derivative's callback.
@@ -470,6 +508,8 @@ struct OdeProblem {
     if (k && list_length(k->arg_shapes) == 1 && value_has_shape(state, car(k->arg_shapes)) &&
         k->nin == shape.dim() && k->nout == shape.dim())
       cb.kernel = k;
+    else
+      cb.kernel = auto_kernel(sysder, state, shape.dim());
     t0 = shape.time_first() && std::isfinite(y[0]) ? y[0] : 0.0;
   }
 
@@ -517,11 +557,10 @@ void check_arity(NativeProc *self, int given, int min, int max) {
   if (given >= min && given <= max) return;
   std::string name;
   print_value(name, Value::object(Tag::Closure, &self->print_as), false);
-  runtime_error(current_call_loc(), "The procedure " + name + " has been called with " +
-                                        std::to_string(given) +
-                                        (given == 1 ? " argument" : " arguments") +
-                                        "; it requires between " + std::to_string(min) +
-                                        " and " + std::to_string(max) + " arguments.");
+  runtime_error(current_call_loc(),
+                "The procedure " + name + " has been called with " + std::to_string(given) +
+                    (given == 1 ? " argument" : " arguments") + "; it requires between " +
+                    std::to_string(min) + " and " + std::to_string(max) + " arguments.");
 }
 
 // ((state-advancer sysder . params) state dt [eps [integrator]]): the state
@@ -723,14 +762,13 @@ Value P_nelder_mead(Value *a, int n) {
   std::vector<double> x = arg_point(a, 1, who, is_list);
   double step = arg_tolerance(a, n, 2, kNelderStep, who);
   double tol = arg_tolerance(a, n, 3, kNelderTolerance, who);
-  int max_iter = is_missing(a, n, 4)
-                     ? kNelderMaxIter
-                     : static_cast<int>(arg_bounded(a, 4, 1, 100000000, who));
+  int max_iter =
+      is_missing(a, n, 4) ? kNelderMaxIter : static_cast<int>(arg_bounded(a, 4, 1, 100000000, who));
   VectorCallback cb(loc, who, f, x.size(), false);
   NelderMeadResult r = nelder_mead(cb, std::move(x), step, tol, max_iter);
   Value best = cons(point_value(r.x.data(), r.x.size(), false), Value::flonum(r.fmin));
-  return list({intern(r.status == SICM_SUCCESS ? "ok" : "maxcount"), best,
-               Value::fixnum(r.iterations)});
+  return list(
+      {intern(r.status == SICM_SUCCESS ? "ok" : "maxcount"), best, Value::fixnum(r.iterations)});
 }
 
 // (multidimensional-minimize f initial): the point near initial (a list or a
@@ -749,8 +787,8 @@ Value P_multidimensional_minimize(Value *a, int n) {
     numeric_error(loc, who,
                   "the minimizer did not converge in " + std::to_string(r.iterations) +
                       " iterations (best point " +
-                      write_string(point_value(r.x.data(), r.x.size(), is_list)) +
-                      ", value " + number_text(r.fmin) + ")");
+                      write_string(point_value(r.x.data(), r.x.size(), is_list)) + ", value " +
+                      number_text(r.fmin) + ")");
   return point_value(r.x.data(), r.x.size(), is_list);
 }
 
