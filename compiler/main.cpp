@@ -1,4 +1,5 @@
 // The sicm command: run, repl (build and emit-c come with the code generator).
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "codegen/kernel.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
 #include "eval/plot.hpp"
@@ -30,6 +32,8 @@ const char kUsage[] =
     "usage: sicm run FILE [--plot-dir DIR]\n"
     "                            evaluate a program, printing each top-level value;\n"
     "                            plots (frame ...) are written to DIR (default .)\n"
+    "       sicm emit-c FILE     run the program quietly and print the C of every\n"
+    "                            kernel it compiles (state derivatives, ...)\n"
     "       sicm repl            interactive read-eval-print loop\n"
     "       sicm --version\n";
 
@@ -51,6 +55,41 @@ int run_file(const std::string &path) {
   return 0;
 }
 
+// sicm emit-c: the program's output is discarded (plots go to a scratch
+// directory); what is printed is the C source of each kernel compiled.
+std::string g_emitted;
+
+void collect_kernel(const sicm::Kernel *k) {
+  if (g_emitted.find(k->c_source) != std::string::npos) return; // the same kernel again
+  g_emitted += "/* ---- kernel " + k->c_name + " ---- */\n" + k->c_source + "\n";
+}
+
+int emit_c(const std::string &path) {
+  sicm::set_kernel_listener(collect_kernel);
+  char dir[] = "/tmp/sicm-emit-XXXXXX";
+  if (mkdtemp(dir)) sicm::set_plot_directory(dir);
+  std::fflush(stdout);
+  int saved = dup(1);
+  int null_fd = open("/dev/null", O_WRONLY);
+  if (saved >= 0 && null_fd >= 0) dup2(null_fd, 1);
+  int status = 0;
+  try {
+    status = run_file(path);
+  } catch (...) {
+    sicm::flush_output();
+    if (saved >= 0) dup2(saved, 1);
+    throw;
+  }
+  sicm::flush_output();
+  if (saved >= 0) dup2(saved, 1);
+  if (null_fd >= 0) close(null_fd);
+  if (status == 0) {
+    if (g_emitted.empty()) std::fputs("/* this program compiles no kernels */\n", stdout);
+    std::fputs(g_emitted.c_str(), stdout);
+  }
+  return status;
+}
+
 int dispatch(const std::vector<std::string> &args) {
   if (args.empty() || args[0] == "repl") {
     sicm::ReplOptions opts;
@@ -65,6 +104,13 @@ int dispatch(const std::vector<std::string> &args) {
   if (cmd == "--help" || cmd == "-h") {
     std::fputs(kUsage, stdout);
     return 0;
+  }
+  if (cmd == "emit-c") {
+    if (args.size() != 2) {
+      std::fputs(kUsage, stderr);
+      return kExitUsage;
+    }
+    return emit_c(args[1]);
   }
   if (cmd == "run") {
     std::string file;

@@ -43,8 +43,8 @@ using KernelFn = void (*)(const double *in, double *out, const double *p);
 struct Kernel {
   KernelFn fn = nullptr;
   size_t nin = 0, nout = 0;
-  Value arg_shapes;   // the sample arguments as given (a list): their shapes
-  Value result_shape; // a structure of the result's shape, or a number for a scalar result
+  Value arg_shapes;     // the sample arguments as given (a list): their shapes
+  Value result_shape;   // a structure of the result's shape, or a number for a scalar result
   std::string name;     // the procedure's name as the user wrote it (for printing)
   std::string c_name;   // the C function's name (generated, [A-Za-z0-9_] only)
   std::string c_source; // the whole translation unit given to the C compiler
@@ -60,6 +60,11 @@ struct Kernel {
 // The procedure runs twice: once on symbols, once at the sample arguments to
 // check the kernel, so its side effects happen then, not when the kernel runs.
 Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not);
+
+// Called with every kernel compile_kernel makes (sicm emit-c lists them);
+// null (the default) for none.
+using KernelListener = void (*)(const Kernel *k);
+void set_kernel_listener(KernelListener listener);
 
 // Run the kernel: in has k->nin doubles, out room for k->nout.
 void kernel_call(const Kernel *k, const double *in, double *out);

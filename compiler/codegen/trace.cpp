@@ -15,12 +15,12 @@
 #include <unordered_set>
 
 #include "algebra/structure.hpp"
+#include "algebra/symbolic.hpp"
 #include "codegen/emit_c.hpp"
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
-#include "eval/primitive.hpp"
-#include "algebra/symbolic.hpp"
 #include "eval/number.hpp"
+#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 
@@ -35,8 +35,8 @@ constexpr double kSampleTolerance = 1e-9;
 namespace {
 
 const char *ordinal(size_t i) {
-  static const char *const names[] = {"first", "second", "third", "fourth", "fifth",
-                                      "sixth", "seventh", "eighth", "ninth", "tenth"};
+  static const char *const names[] = {"first", "second",  "third",  "fourth", "fifth",
+                                      "sixth", "seventh", "eighth", "ninth",  "tenth"};
   return i < 10 ? names[i] : "a later";
 }
 
@@ -229,6 +229,14 @@ bool agrees_at_sample(const Kernel *k, Value proc, Value sample_args, std::strin
 
 } // namespace
 
+namespace {
+KernelListener g_kernel_listener = nullptr;
+} // namespace
+
+void set_kernel_listener(KernelListener listener) {
+  g_kernel_listener = listener;
+}
+
 Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not) {
   std::string ignored;
   if (!why_not) why_not = &ignored;
@@ -253,6 +261,7 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   k->c_source = std::move(source);
   k->so_path = so;
   if (!agrees_at_sample(k, proc, sample_args, why_not)) return nullptr;
+  if (g_kernel_listener) g_kernel_listener(k);
   return k;
 }
 
