@@ -3,6 +3,7 @@
 #   make            build build/sicm and build/libsicmrt.a
 #   make check      install missing Debian packages, build, run every test
 #   make demo       install missing Debian packages, build, run an example scene
+#   make examples   run every figure scene at full size into build/figures
 #   make install    install sicm under $(PREFIX)
 #   make clean
 #
@@ -44,7 +45,7 @@ SICM    := $(BUILD)/sicm
 RTLIB   := $(BUILD)/libsicmrt.a
 UNITBIN := $(BUILD)/unit-tests
 
-.PHONY: all check demo install clean deps unit
+.PHONY: all check demo examples install clean deps unit
 all: $(SICM) $(RTLIB)
 
 $(BUILD)/%.o: %.cpp
@@ -85,6 +86,11 @@ demo: deps
 	@mkdir -p $(BUILD)/demo
 	$(SICM) run examples/demo.sicm --plot-dir $(BUILD)/demo
 	@echo "plot: $(BUILD)/demo/driven-pendulum.svg (data: $(BUILD)/demo/driven-pendulum.tsv)"
+
+# Every figure scene at full size, into $(BUILD)/figures.
+examples: deps
+	@$(MAKE) --no-print-directory all
+	@scripts/run-examples --sicm $(SICM) --out $(BUILD)/figures
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/sicm

@@ -469,6 +469,11 @@ struct CompiledSysder {
 };
 gcvec<CompiledSysder> g_compiled; // static, hence a root for the collector
 constexpr size_t kCompiledMemo = 32;
+// Each kernel is a shared object loaded for good (and a root set of the
+// collector); a parameter sweep that makes a new system per point would
+// load thousands. Past this many, derivatives are interpreted.
+constexpr size_t kMaxAutoKernels = 64;
+size_t g_auto_kernels = 0;
 
 bool kernels_enabled() {
   static const bool enabled = [] {
@@ -482,8 +487,10 @@ const Kernel *auto_kernel(Value sysder, Value state, size_t dim) {
   if (!kernels_enabled() || !is_procedure(sysder)) return nullptr;
   for (const CompiledSysder &c : g_compiled)
     if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape)) return c.kernel;
+  if (g_auto_kernels >= kMaxAutoKernels) return nullptr;
   std::string why;
   const Kernel *k = compile_kernel(sysder, list({state}), "system_derivative", &why);
+  if (k) ++g_auto_kernels;
   if (k && (k->nin != dim || k->nout != dim)) k = nullptr;
   if (g_compiled.size() >= kCompiledMemo) g_compiled.erase(g_compiled.begin());
   g_compiled.push_back(CompiledSysder{sysder, state, k});

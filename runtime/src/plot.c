@@ -239,7 +239,7 @@ static int add_line(sicm_plot *p, double x0, double y0, double x1, double y1) {
 
 /* ---- the SVG picture ---------------------------------------------------- */
 
-enum { kWidth = 640, kHeight = 480, kLeft = 70, kRight = 20, kTop = 40, kBottom = 50 };
+enum { kWidth = 660, kHeight = 480, kLeft = 90, kRight = 20, kTop = 40, kBottom = 50 };
 
 static double px(const sicm_plot *p, double x) {
   return kLeft + (x - p->xmin) / (p->xmax - p->xmin) * (kWidth - kLeft - kRight);
@@ -268,21 +268,31 @@ static void write_escaped(FILE *f, const char *s) {
   }
 }
 
+/* A tick label: k * step printed with just the decimals the step needs
+ * (so 0.46, not .4600000000000001), in plain C notation for SVG readers. */
+static void tick_label(char *buf, size_t size, long k, double step) {
+  double value = (double)k * step;
+  int decimals = step >= 1 ? 0 : (int)ceil(-log10(step) - 1e-9);
+  if (decimals > 15) decimals = 15;
+  if (fabs(value) < step * 1e-9) value = 0.0;
+  snprintf(buf, size, "%.*f", decimals, value);
+}
+
 static void write_ticks(FILE *f, const sicm_plot *p) {
-  char label[SICM_DOUBLE_BUFSIZE];
+  char label[64];
   double step = tick_step(p->xmax - p->xmin);
-  for (double t = ceil(p->xmin / step) * step; t <= p->xmax + step * 1e-9; t += step) {
-    double x = px(p, t), y0 = kHeight - kBottom;
-    sicm_format_double(label, fabs(t) < step * 1e-9 ? 0.0 : t);
+  for (long k = (long)ceil(p->xmin / step - 1e-9); k * step <= p->xmax + step * 1e-9; ++k) {
+    double x = px(p, k * step), y0 = kHeight - kBottom;
+    tick_label(label, sizeof label, k, step);
     fprintf(f, "<line x1=\"%.2f\" y1=\"%d\" x2=\"%.2f\" y2=\"%d\" stroke=\"black\"/>\n", x, (int)y0,
             x, (int)y0 + 5);
     fprintf(f, "<text x=\"%.2f\" y=\"%d\" text-anchor=\"middle\">%s</text>\n", x, (int)y0 + 20,
             label);
   }
   step = tick_step(p->ymax - p->ymin);
-  for (double t = ceil(p->ymin / step) * step; t <= p->ymax + step * 1e-9; t += step) {
-    double y = py(p, t);
-    sicm_format_double(label, fabs(t) < step * 1e-9 ? 0.0 : t);
+  for (long k = (long)ceil(p->ymin / step - 1e-9); k * step <= p->ymax + step * 1e-9; ++k) {
+    double y = py(p, k * step);
+    tick_label(label, sizeof label, k, step);
     fprintf(f, "<line x1=\"%d\" y1=\"%.2f\" x2=\"%d\" y2=\"%.2f\" stroke=\"black\"/>\n", kLeft - 5,
             y, kLeft, y);
     fprintf(f, "<text x=\"%d\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", kLeft - 8, y + 4,
