@@ -8,27 +8,9 @@
 #include <gsl/gsl_multimin.h>
 
 #include "sicm/runtime.h"
+#include "watched_fn.h"
 
 enum { kBrentMaxIter = 1000, kGridPoints = 64, kStallLimit = 4 };
-
-/* The user's function of one variable, watched for non-finite values. */
-typedef struct {
-  double (*f)(double, void *);
-  void *params;
-  int bad;
-  double bad_x, bad_value;
-} fn1;
-
-static double call1(double x, void *data) {
-  fn1 *w = data;
-  double v = w->f(x, w->params);
-  if (!isfinite(v) && !w->bad) {
-    w->bad = 1;
-    w->bad_x = x;
-    w->bad_value = v;
-  }
-  return v;
-}
 
 static int bad_value1(const char *who, const fn1 *w) {
   return sicm_error(SICM_EBADFUNC, "%s: the function is not finite at x = %.17g (value %g)", who,

@@ -6,26 +6,9 @@
 #include <gsl/gsl_integration.h>
 
 #include "sicm/runtime.h"
+#include "watched_fn.h"
 
 enum { kMaxIntervals = 1000, kRombergLevels = 20 };
-
-typedef struct {
-  double (*f)(double, void *);
-  void *params;
-  int bad;
-  double bad_x, bad_value;
-} fn1;
-
-static double call1(double x, void *data) {
-  fn1 *w = data;
-  double v = w->f(x, w->params);
-  if (!isfinite(v) && !w->bad) {
-    w->bad = 1;
-    w->bad_x = x;
-    w->bad_value = v;
-  }
-  return v;
-}
 
 static int bad_value(const char *who, const fn1 *w) {
   return sicm_error(SICM_EBADFUNC, "%s: the integrand is not finite at x = %.17g (value %g)", who,

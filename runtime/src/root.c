@@ -6,26 +6,9 @@
 #include <gsl/gsl_roots.h>
 
 #include "sicm/runtime.h"
+#include "watched_fn.h"
 
 enum { kMaxIter = 1000 };
-
-typedef struct {
-  double (*f)(double, void *);
-  void *params;
-  int bad;
-  double bad_x, bad_value;
-} fn1;
-
-static double call1(double x, void *data) {
-  fn1 *w = data;
-  double v = w->f(x, w->params);
-  if (!isfinite(v) && !w->bad) {
-    w->bad = 1;
-    w->bad_x = x;
-    w->bad_value = v;
-  }
-  return v;
-}
 
 int sicm_root_brent(double (*f)(double, void *), void *params, double a, double b, double tol,
                     double *root) {
