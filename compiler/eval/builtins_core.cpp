@@ -1,6 +1,7 @@
 // Core primitives: registration, argument errors, equivalence, predicates,
 // control (apply, values, promises, errors, continuations) and output.
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 
 #include "algebra/structure.hpp"
@@ -325,10 +326,9 @@ Value P_exit(Value *a, int n) {
   std::exit(code);
 }
 
+// MIT's runtime: the processor time used so far, in seconds.
 Value P_runtime(Value *, int) {
-  using namespace std::chrono;
-  double s = duration<double>(steady_clock::now().time_since_epoch()).count();
-  return Value::flonum(s);
+  return Value::flonum(static_cast<double>(std::clock()) / CLOCKS_PER_SEC);
 }
 
 Value P_real_time(Value *, int) {
@@ -425,7 +425,6 @@ void install_core_primitives() {
   define_primitive("write", 1, 2, P_write);
   define_primitive("write-string", 1, 2, P_write_string);
   define_primitive("write-char", 1, 2, P_write_char);
-  define_primitive("write-u8", 1, 2, P_write_char);
   define_primitive("newline", 0, 1, P_newline);
   define_primitive("fresh-line", 0, 1, P_fresh_line);
   define_primitive("write-line", 1, 2, P_write_line);
