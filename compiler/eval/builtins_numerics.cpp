@@ -25,7 +25,9 @@
 // records messages instead of printing them.
 #include "eval/numerics.hpp"
 
+#include <algorithm>
 #include <cfloat>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -34,6 +36,8 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
@@ -594,6 +598,39 @@ Value P_state_advancer(Value *a, int n) {
                               &g_advancer_lambda);
 }
 
+// A progress bar on stderr for integrations that run longer than a second,
+// drawn only when stderr is a terminal (never in pipes, logs or tests), at
+// most ten times a second, and erased when the integration ends.
+class ProgressBar {
+public:
+  ProgressBar(double t0, double t1) : t0_(t0), t1_(t1), start_(now()), last_(start_) {
+    enabled_ = isatty(2) && t1 != t0;
+  }
+  ~ProgressBar() {
+    if (drawn_) std::fprintf(stderr, "\r%*s\r", 60, "");
+  }
+  void update(double t) {
+    if (!enabled_) return;
+    double s = now();
+    if (s - start_ < 1.0 || s - last_ < 0.1) return;
+    last_ = s;
+    double f = std::clamp((t - t0_) / (t1_ - t0_), 0.0, 1.0);
+    int filled = static_cast<int>(f * 30);
+    std::fprintf(stderr, "\revolve [%.*s%*s] %3d%% t = %.6g", filled,
+                 "==============================", 30 - filled, "", static_cast<int>(f * 100), t);
+    std::fflush(stderr);
+    drawn_ = true;
+  }
+
+private:
+  static double now() {
+    using namespace std::chrono;
+    return duration<double>(steady_clock::now().time_since_epoch()).count();
+  }
+  double t0_, t1_, start_, last_;
+  bool enabled_ = false, drawn_ = false;
+};
+
 // ((evolve sysder . params) state monitor dt final-time [eps [integrator]]):
 // calls (monitor state) at the initial state and every dt until the final
 // time (the last interval is shortened to end there); returns the final state.
@@ -616,12 +653,14 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   RuntimeErrorScope scope;
   OdePtr ode = p.make_integrator(T, eps);
   double t = p.t0;
+  ProgressBar progress(p.t0, t_final);
   for (long k = 1; std::fabs(t_final - t) > 0; ++k) {
     double tk = p.t0 + static_cast<double>(k) * step;
     if ((step > 0 ? t_final - tk : tk - t_final) <= near_end) tk = t_final;
     p.evolve_to(ode.get(), t, tk);
     state = p.state_at(tk);
     apply_procedure(monitor, &state, 1);
+    progress.update(tk);
   }
   return state;
 }
