@@ -269,6 +269,8 @@ Value Reader::read_hash(SrcLoc start) {
   if (c == '(') {
     get();
     Value items = read_list(')', start);
+    if (list_length(items) < 0)
+      syntax_error(start, "ill-formed vector: '.' is not allowed in #( ... )");
     gcvec<Value> v = list_to_vector(items);
     Value vec = make_vector(v.size(), Value::nil());
     for (size_t i = 0; i < v.size(); ++i)
@@ -358,6 +360,11 @@ Value Reader::read_atom(SrcLoc start) {
   }
   if (auto n = parse_number(token)) return *n;
   if (token == ".") syntax_error(start, "unexpected '.' outside a list");
+  // n/0 is a rational with a zero denominator, not a symbol.
+  size_t slash = token.find('/');
+  if (slash != std::string_view::npos && slash + 2 == token.size() && token.back() == '0' &&
+      parse_number(token.substr(0, slash)))
+    syntax_error(start, "bad number '" + std::string(token) + "': division by zero");
   return intern(token);
 }
 
