@@ -143,7 +143,13 @@ void *evaluator_thread(void *arg) {
     job->status = dispatch(job->args);
   } catch (const sicm::Error &e) {
     sicm::flush_output();
-    sicm::report_error(stderr, e);
+    sicm::Error shown = e;
+    sicm::SrcLoc user = sicm::current_toplevel_loc();
+    if (sicm::is_library_loc(e.loc) && user.known() && shown.note.empty())
+      shown.note = "raised inside the library while evaluating " + sicm::source_name(user.file) +
+                   ":" + std::to_string(user.line) + ":" + std::to_string(user.col) + ": " +
+                   std::string(sicm::source_line(user.file, user.line));
+    sicm::report_error(stderr, shown);
     job->status = e.exit_code();
   } catch (const std::bad_alloc &) {
     sicm::flush_output();

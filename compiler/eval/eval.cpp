@@ -21,6 +21,7 @@ namespace {
 char *g_stack_limit = nullptr;
 SrcLoc g_call_loc;
 const void *g_apply_primitive = nullptr; // the `apply` primitive, called in tail position
+uint32_t g_first_user_file = UINT32_MAX; // sources from here on are the user's, not the library's
 
 // Evaluate operands into a buffer; small calls use the C++ stack.
 constexpr int kSmallArgs = 8;
@@ -149,6 +150,14 @@ Frame *make_frame(Frame *parent, uint32_t size) {
   for (uint32_t i = 0; i < size; ++i)
     f->slots[i].tag = Tag::Unassigned;
   return f;
+}
+
+void set_first_user_file(uint32_t file) {
+  g_first_user_file = file;
+}
+
+bool is_library_loc(SrcLoc loc) {
+  return loc.known() && loc.file < g_first_user_file;
 }
 
 void register_apply_primitive(Value apply) {

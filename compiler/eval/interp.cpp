@@ -92,6 +92,7 @@ void init_interpreter() {
   install_numerics_primitives();
   install_kernel_primitives();
   load_embedded_stdlib();
+  set_first_user_file(register_source("<first user source>", "") + 1);
 }
 
 Value eval_toplevel(Value datum, SrcLoc loc) {
@@ -136,10 +137,19 @@ void check_program(const gcvec<ReadForm> &forms) {
   }
 }
 
+namespace {
+SrcLoc g_toplevel_loc;
+} // namespace
+
+SrcLoc current_toplevel_loc() {
+  return g_toplevel_loc;
+}
+
 void run_source(uint32_t file) {
   gcvec<ReadForm> forms = read_all(file);
   check_program(forms);
   for (const ReadForm &f : forms) {
+    g_toplevel_loc = f.loc;
     Value v = eval_toplevel(f.datum, f.loc);
     if (is_printable_toplevel(f.datum, v)) {
       output(write_string(v));

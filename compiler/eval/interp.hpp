@@ -29,6 +29,9 @@ void run_source(uint32_t file);
 // Error listing the first unknown name (with a "did you mean" note).
 void check_program(const gcvec<struct ReadForm> &forms);
 
+// Where the top-level form being evaluated by run_source starts.
+SrcLoc current_toplevel_loc();
+
 // The names bound in the global environment (for REPL completion).
 std::vector<std::string> global_names();
 

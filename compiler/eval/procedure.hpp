@@ -68,6 +68,12 @@ Frame *make_frame(Frame *parent, uint32_t size);
 
 // Apply any procedure to arguments (used by primitives such as map, apply, sort).
 Value apply_procedure(Value proc, Value *args, int nargs);
+// Sources registered from `file` on are the user's (the library's come
+// first), so errors raised inside the library can say which of the user's
+// forms was running.
+void set_first_user_file(uint32_t file);
+bool is_library_loc(SrcLoc loc);
+
 // Tell the evaluator which primitive is `apply`, so calls to it are tail calls.
 void register_apply_primitive(Value apply);
 
