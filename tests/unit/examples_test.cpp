@@ -74,7 +74,7 @@ std::string small_version(const std::string &text) {
 }
 
 struct RunResult {
-  int status = -1;   // exit status, or 128 + signal
+  int status = -1; // exit status, or 128 + signal
   bool timed_out = false;
   std::string output; // stdout and stderr, for the failure message
 };
@@ -190,8 +190,8 @@ GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(ExampleScene);
 // The scenes are there at all (the directory is read relative to the
 // repository root, where the unit tests run).
 TEST(ExampleScenes, Exist) {
-  EXPECT_GE(scene_names().size(), 20u) << "examples/figure-*.sicm not found from "
-                                       << fs::current_path();
+  EXPECT_GE(scene_names().size(), 20u)
+      << "examples/figure-*.sicm not found from " << fs::current_path();
 }
 
 } // namespace

@@ -6,27 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "capture_errors.hpp"
 #include "sicm/runtime.h"
 
 namespace {
-
-// Collects what goes through the error hook while in scope, instead of printing it.
-class CaptureErrors {
-public:
-  CaptureErrors() { previous_ = sicm_set_error_handler(&CaptureErrors::handle); }
-  ~CaptureErrors() {
-    sicm_set_error_handler(previous_);
-    messages().clear();
-  }
-  static std::vector<std::string> &messages() {
-    static std::vector<std::string> m;
-    return m;
-  }
-
-private:
-  static void handle(const char *reason, int) { messages().push_back(reason); }
-  sicm_error_handler_t *previous_;
-};
 
 std::string format(double x) {
   char buf[SICM_DOUBLE_BUFSIZE];
