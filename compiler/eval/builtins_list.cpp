@@ -224,6 +224,7 @@ Value P_member(Value *a, int n) {
 }
 
 template <bool (*Same)(Value, Value)> Value assoc_generic(Value x, Value alist, const char *who) {
+  if (list_length(alist) < 0) wrong_type(alist, 2, who);
   for (Value p = alist; is_pair(p); p = cdr(p)) {
     Value entry = car(p);
     if (!is_pair(entry)) {
