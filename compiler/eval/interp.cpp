@@ -111,16 +111,17 @@ std::vector<std::string> global_names() {
   return bound_global_names();
 }
 
-void check_program(const gcvec<ReadForm> &forms) {
+gcvec<Node *> check_program(const gcvec<ReadForm> &forms) {
   std::vector<Symbol *> defined;
   for (const ReadForm &f : forms)
     toplevel_defined_names(f.datum, defined);
   std::unordered_set<Symbol *> defined_set(defined.begin(), defined.end());
   std::vector<GlobalUse> uses;
+  gcvec<Node *> nodes;
   g_uses = &uses;
   try {
     for (const ReadForm &f : forms)
-      analyze_form(f.datum, f.loc, record_use);
+      nodes.push_back(analyze_form(f.datum, f.loc, record_use));
   } catch (...) {
     g_uses = nullptr;
     throw;
@@ -135,6 +136,7 @@ void check_program(const gcvec<ReadForm> &forms) {
     throw Error(ErrorKind::Syntax, u.loc, "Unbound variable: " + u.name->name,
                 near.empty() ? "" : "did you mean '" + near + "'?");
   }
+  return nodes;
 }
 
 namespace {
@@ -147,10 +149,13 @@ SrcLoc current_toplevel_loc() {
 
 void run_source(uint32_t file) {
   gcvec<ReadForm> forms = read_all(file);
-  check_program(forms);
-  for (const ReadForm &f : forms) {
+  // Analyzed once, for the check and for running: analysis depends only on
+  // the forms themselves, not on what earlier forms did when they ran.
+  gcvec<Node *> nodes = check_program(forms);
+  for (size_t i = 0; i < forms.size(); ++i) {
+    const ReadForm &f = forms[i];
     g_toplevel_loc = f.loc;
-    Value v = eval_toplevel(f.datum, f.loc);
+    Value v = eval(nodes[i], nullptr);
     if (is_printable_toplevel(f.datum, v)) {
       output(write_string(v));
       output("\n");

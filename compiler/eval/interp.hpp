@@ -24,10 +24,11 @@ bool is_printable_toplevel(Value datum, Value result);
 // printable values (as `sicm run` does) to stdout. Throws Error.
 void run_source(uint32_t file);
 
-// Check a whole program before running it: every free identifier must be
-// defined by the program or by the global environment. Throws a Syntax
-// Error listing the first unknown name (with a "did you mean" note).
-void check_program(const gcvec<struct ReadForm> &forms);
+// Analyze a whole program before running it, and check that every free
+// identifier is defined by the program or by the global environment. Throws
+// a Syntax Error naming the first unknown name (with a "did you mean" note).
+// Returns the analyzed forms, in order, ready to evaluate.
+gcvec<struct Node *> check_program(const gcvec<struct ReadForm> &forms);
 
 // Where the top-level form being evaluated by run_source starts.
 SrcLoc current_toplevel_loc();
