@@ -1,4 +1,4 @@
-// The sicm command: run, repl (build and emit-c come with the code generator).
+// The sicm command: run, build, emit-c, emit-kernels, repl.
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "codegen/build_exe.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
@@ -32,8 +33,13 @@ const char kUsage[] =
     "usage: sicm run FILE [--plot-dir DIR]\n"
     "                            evaluate a program, printing each top-level value;\n"
     "                            plots (frame ...) are written to DIR (default .)\n"
-    "       sicm emit-c FILE     run the program quietly and print the C of every\n"
-    "                            kernel it compiles (state derivatives, ...)\n"
+    "       sicm build FILE [-o EXE] [-O0|-O1|-O2|-O3] [--keep-c]\n"
+    "                            compile to an executable (default: FILE without\n"
+    "                            .sicm); --keep-c leaves the C as EXE.c\n"
+    "       sicm emit-c FILE     print the C that sicm build compiles\n"
+    "       sicm emit-kernels FILE\n"
+    "                            run the program quietly and print the C of every\n"
+    "                            kernel sicm run compiles (state derivatives, ...)\n"
     "       sicm repl            interactive read-eval-print loop\n"
     "       sicm --version\n";
 
@@ -105,12 +111,43 @@ int dispatch(const std::vector<std::string> &args) {
     std::fputs(kUsage, stdout);
     return 0;
   }
-  if (cmd == "emit-c") {
+  if (cmd == "emit-kernels") {
     if (args.size() != 2) {
       std::fputs(kUsage, stderr);
       return kExitUsage;
     }
     return emit_c(args[1]);
+  }
+  if (cmd == "build" || cmd == "emit-c") {
+    sicm::BuildOptions o;
+    o.emit_only = cmd == "emit-c";
+    for (size_t i = 1; i < args.size(); ++i) {
+      const std::string &a = args[i];
+      if (a == "-o" && i + 1 < args.size() && !o.emit_only) {
+        o.output = args[++i];
+      } else if (!o.emit_only && (a == "-O0" || a == "-O1" || a == "-O2" || a == "-O3")) {
+        o.opt_level = a;
+      } else if (a == "--keep-c" && !o.emit_only) {
+        o.keep_c = true;
+      } else if (o.input.empty() && a.rfind("-", 0) != 0) {
+        o.input = a;
+      } else {
+        std::fputs(kUsage, stderr);
+        return kExitUsage;
+      }
+    }
+    if (o.input.empty()) {
+      std::fputs(kUsage, stderr);
+      return kExitUsage;
+    }
+    if (o.output.empty()) {
+      o.output = o.input;
+      if (o.output.size() > 5 && o.output.compare(o.output.size() - 5, 5, ".sicm") == 0)
+        o.output.resize(o.output.size() - 5);
+      else
+        o.output += ".out";
+    }
+    return sicm::build_program(o);
   }
   if (cmd == "run") {
     std::string file;

@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <unordered_map>
 #include <unordered_set>
@@ -73,28 +74,32 @@ bool negative_term(ExprId id) {
 
 class Emitter {
 public:
-  explicit Emitter(const Trace &t) : t_(t) {
-    for (size_t i = 0; i < t.inputs.size(); ++i)
-      input_[t.inputs[i]] = i;
+  // spell gives the C text of a symbol (an atom); temporaries are named
+  // temp_prefix followed by a number.
+  Emitter(std::vector<ExprId> outputs, std::function<std::string(Symbol *)> spell,
+          std::string temp_prefix = "t")
+      : outputs_(std::move(outputs)), spell_(std::move(spell)),
+        temp_prefix_(std::move(temp_prefix)) {
     collect();
     plan();
   }
 
-  std::string function(const std::string &c_name, bool is_static) {
+  // Statements that compute output j into targets[j].
+  std::string assignments(const std::vector<std::string> &targets, const std::string &indent) {
     for (ExprId id : nodes_)
       if (wants_name_.count(id) && !name_.count(id)) emit_named(id);
-    for (size_t j = 0; j < t_.outputs.size(); ++j) {
-      Code c = ref(t_.outputs[j]);
-      body_ += "  out[" + std::to_string(j) + "] = " + c.text + ";\n";
+    for (size_t j = 0; j < outputs_.size(); ++j) {
+      Code c = ref(outputs_[j]);
+      body_ += "  " + targets[j] + " = " + c.text + ";\n";
     }
-    std::string f = is_static ? "static " : "";
-    f += "void " + c_name + "(const double *in, double *out, const double *p) {\n";
-    if (!uses_in_) f += "  (void)in;\n";
-    if (t_.outputs.empty()) f += "  (void)out;\n";
-    f += "  (void)p;\n";
-    f += body_;
-    f += "}\n";
-    return f;
+    std::string out;
+    size_t start = 0;
+    while (start < body_.size()) {
+      size_t end = body_.find('\n', start);
+      out += indent + body_.substr(start, end - start) + "\n";
+      start = end + 1;
+    }
+    return out;
   }
 
 private:
@@ -103,7 +108,7 @@ private:
   // output).
   void collect() {
     std::unordered_set<ExprId> seen;
-    std::vector<ExprId> stack(t_.outputs.begin(), t_.outputs.end());
+    std::vector<ExprId> stack(outputs_.begin(), outputs_.end());
     while (!stack.empty()) {
       ExprId id = stack.back();
       stack.pop_back();
@@ -120,7 +125,7 @@ private:
       for (uint32_t i = 0; i < expr_node(id).nargs; ++i)
         ++uses_[args[i]];
     }
-    for (ExprId id : t_.outputs)
+    for (ExprId id : outputs_)
       ++uses_[id];
   }
 
@@ -150,9 +155,10 @@ private:
     }
   }
 
-  std::string temp() { return "t" + std::to_string(ntemps_++); }
-  static bool is_temporary(const std::string &s) {
-    return s.size() > 1 && s[0] == 't' && s.find_first_not_of("0123456789", 1) == std::string::npos;
+  std::string temp() { return temp_prefix_ + std::to_string(ntemps_++); }
+  bool is_temporary(const std::string &s) const {
+    return s.size() > temp_prefix_.size() && s.compare(0, temp_prefix_.size(), temp_prefix_) == 0 &&
+           s.find_first_not_of("0123456789", temp_prefix_.size()) == std::string::npos;
   }
 
   // Give id a name, emitting the statement that computes it. Every node it
@@ -189,12 +195,7 @@ private:
     switch (node.kind) {
     case ExprKind::Rational:
     case ExprKind::Flonum: return literal(number_value(id));
-    case ExprKind::Symbol: {
-      auto in = input_.find(node.sym);
-      SICM_ASSERT(in != input_.end()); // trace_procedure checked the symbols
-      uses_in_ = true;
-      return {"in[" + std::to_string(in->second) + "]", kAtom};
-    }
+    case ExprKind::Symbol: return {spell_(node.sym), kAtom};
     case ExprKind::Apply: return inline_form(id);
     case ExprKind::Call: break; // trace_procedure refuses Calls
     }
@@ -335,8 +336,9 @@ private:
     internal_failure(__FILE__, __LINE__, "an operator without a C form");
   }
 
-  const Trace &t_;
-  std::unordered_map<Symbol *, size_t> input_;
+  std::vector<ExprId> outputs_;
+  std::function<std::string(Symbol *)> spell_;
+  std::string temp_prefix_;
   std::vector<ExprId> nodes_; // reachable from the outputs, increasing ids
   std::unordered_map<ExprId, uint32_t> uses_;
   std::unordered_set<ExprId> wants_name_;
@@ -345,7 +347,6 @@ private:
   std::map<std::pair<ExprId, uint64_t>, std::string> powers_; // (base, m) -> a name of base^m
   std::string body_;
   size_t ntemps_ = 0;
-  bool uses_in_ = false;
 };
 
 } // namespace
@@ -375,14 +376,41 @@ std::string c_double_literal(double d) {
 }
 
 std::string emit_kernel_function(const Trace &t, const std::string &c_name, bool is_static) {
-  return Emitter(t).function(c_name, is_static);
+  std::unordered_map<Symbol *, size_t> input;
+  for (size_t i = 0; i < t.inputs.size(); ++i)
+    input[t.inputs[i]] = i;
+  bool uses_in = false;
+  auto spell = [&](Symbol *s) {
+    auto in = input.find(s);
+    SICM_ASSERT(in != input.end()); // trace_procedure checked the symbols
+    uses_in = true;
+    return "in[" + std::to_string(in->second) + "]";
+  };
+  std::vector<std::string> targets;
+  for (size_t j = 0; j < t.outputs.size(); ++j)
+    targets.push_back("out[" + std::to_string(j) + "]");
+  std::string body = Emitter(t.outputs, spell).assignments(targets, "");
+  std::string f = is_static ? "static " : "";
+  f += "void " + c_name + "(const double *in, double *out, const double *p) {\n";
+  if (!uses_in) f += "  (void)in;\n";
+  if (t.outputs.empty()) f += "  (void)out;\n";
+  f += "  (void)p;\n";
+  f += body;
+  f += "}\n";
+  return f;
+}
+
+std::string emit_c_assignments(const std::vector<ExprId> &values,
+                               const std::vector<std::string> &targets,
+                               const std::function<std::string(Symbol *)> &spell,
+                               const std::string &temp_prefix, const std::string &indent) {
+  return Emitter(values, spell, temp_prefix).assignments(targets, indent);
 }
 
 std::string emit_kernel_unit(const Trace &t, const std::string &c_name,
                              std::string_view source_name) {
   std::string s = "/* sicm kernel " + c_sanitize(source_name, 64) + ": " +
-                  std::to_string(t.inputs.size()) + " inputs, " +
-                  std::to_string(t.outputs.size()) +
+                  std::to_string(t.inputs.size()) + " inputs, " + std::to_string(t.outputs.size()) +
                   " outputs. Generated by the sicm compiler; do not edit. */\n";
   s += "#define _GNU_SOURCE\n#include <math.h>\n\n";
   s += "void " + c_name + "(const double *in, double *out, const double *p);\n\n";

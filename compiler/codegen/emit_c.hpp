@@ -6,8 +6,10 @@
 // text except names sanitized to [A-Za-z0-9_].
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "codegen/trace.hpp"
 
@@ -23,6 +25,16 @@ std::string emit_kernel_function(const Trace &t, const std::string &c_name, bool
 // function.
 std::string emit_kernel_unit(const Trace &t, const std::string &c_name,
                              std::string_view source_name);
+
+// C statements (each line starting with `indent`) that compute values[j]
+// into the C lvalue targets[j], with CSE across all the values. A symbol is
+// written as spell(symbol) (an atom: a name or an array element);
+// temporaries are declared as temp_prefix followed by a number, so two
+// calls with different prefixes can share a C block.
+std::string emit_c_assignments(const std::vector<ExprId> &values,
+                               const std::vector<std::string> &targets,
+                               const std::function<std::string(Symbol *)> &spell,
+                               const std::string &temp_prefix, const std::string &indent);
 
 // s with every byte outside [A-Za-z0-9_] replaced by '_', cut to max_len
 // bytes; "anonymous" if s is empty.

@@ -133,12 +133,30 @@ bool equal(Value a, Value b) {
 namespace {
 std::string *g_capture = nullptr; // with-output-to-string redirects here
 int g_column = 0;
+OutputHook g_output_hook = nullptr; // sicm build: output becomes residual statements
 } // namespace
+
+namespace {
+PrintPreparer g_print_preparer = nullptr;
+} // namespace
+
+void set_print_preparer(PrintPreparer prepare) {
+  g_print_preparer = prepare;
+}
+PrintPreparer print_preparer() {
+  return g_print_preparer;
+}
+
+void set_output_hook(OutputHook hook) {
+  g_output_hook = hook;
+}
 
 void output(std::string_view s) {
   if (s.empty()) return;
   if (g_capture) {
     g_capture->append(s);
+  } else if (g_output_hook) {
+    g_output_hook(s);
   } else {
     std::fwrite(s.data(), 1, s.size(), stdout);
   }

@@ -43,6 +43,7 @@
 #include "algebra/structure.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/number.hpp"
+#include "eval/numerics_defaults.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
@@ -51,17 +52,6 @@
 namespace sicm {
 
 namespace {
-
-// ---- defaults (scmutils' values) --------------------------------------------
-
-constexpr double kIntegralTolerance = 1e-11; // *definite-integral-allowable-error*
-constexpr double kMinimizeTolerance = 1e-5;  // brent-error
-constexpr double kAdvancerTolerance = 1e-12; // *default-advancer-tolerance*
-constexpr double kNelderStep = 0.01;         // nelder-start-step
-constexpr double kNelderTolerance = 1e-10;   // simplex size (see P_nelder_mead)
-constexpr int kNelderMaxIter = 1000;         // nelder-maxiter
-constexpr int kBisectBreak = 60;             // *bisect-break*
-constexpr long kBisectMaxIter = 10000;
 
 // ---- the runtime's error hook -------------------------------------------------
 
@@ -427,16 +417,35 @@ using OdePtr = std::unique_ptr<sicm_ode, OdeDeleter>;
 
 Symbol *g_method_variable = nullptr; // *ode-integration-method*
 
-const sicm_ode_step_type *integrator_for(const std::string &name) {
-  if (name == "bulirsch-stoer" || name == "bs") return sicm_ode_step_bs;
-  if (name == "rk8pd") return sicm_ode_step_rk8pd;
-  if (name == "rkf45" || name == "qcrk4") return sicm_ode_step_rkf45;
-  if (name == "rkck") return sicm_ode_step_rkck;
-  if (name == "msbdf" || name == "gear" || name == "explicit-gear" || name == "qcctrap2")
-    return sicm_ode_step_msbdf;
-  if (name == "cvode-adams") return sicm_ode_step_cvode_adams;
-  if (name == "cvode-bdf") return sicm_ode_step_cvode_bdf;
+struct IntegratorName {
+  const char *name;
+  const sicm_ode_step_type *const *type;
+  const char *c_name;
+};
+const IntegratorName kIntegrators[] = {
+    {"bulirsch-stoer", &sicm_ode_step_bs, "sicm_ode_step_bs"},
+    {"bs", &sicm_ode_step_bs, "sicm_ode_step_bs"},
+    {"rk8pd", &sicm_ode_step_rk8pd, "sicm_ode_step_rk8pd"},
+    {"rkf45", &sicm_ode_step_rkf45, "sicm_ode_step_rkf45"},
+    {"qcrk4", &sicm_ode_step_rkf45, "sicm_ode_step_rkf45"},
+    {"rkck", &sicm_ode_step_rkck, "sicm_ode_step_rkck"},
+    {"msbdf", &sicm_ode_step_msbdf, "sicm_ode_step_msbdf"},
+    {"gear", &sicm_ode_step_msbdf, "sicm_ode_step_msbdf"},
+    {"explicit-gear", &sicm_ode_step_msbdf, "sicm_ode_step_msbdf"},
+    {"qcctrap2", &sicm_ode_step_msbdf, "sicm_ode_step_msbdf"},
+    {"cvode-adams", &sicm_ode_step_cvode_adams, "sicm_ode_step_cvode_adams"},
+    {"cvode-bdf", &sicm_ode_step_cvode_bdf, "sicm_ode_step_cvode_bdf"},
+};
+
+const IntegratorName *find_integrator(const std::string &name) {
+  for (const IntegratorName &i : kIntegrators)
+    if (name == i.name) return &i;
   return nullptr;
+}
+
+const sicm_ode_step_type *integrator_for(const std::string &name) {
+  const IntegratorName *i = find_integrator(name);
+  return i ? *i->type : nullptr;
 }
 
 // The integrator named by argument i, or by *ode-integration-method* when
@@ -926,6 +935,11 @@ Value P_bisect(Value *a, int n) {
 }
 
 } // namespace
+
+const char *integrator_c_name(const std::string &name) {
+  const IntegratorName *i = find_integrator(name);
+  return i ? i->c_name : nullptr;
+}
 
 void install_numerics_primitives() {
   g_method_variable = intern("*ode-integration-method*").symbol();

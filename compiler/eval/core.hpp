@@ -15,6 +15,15 @@ bool equal(Value a, Value b);
 
 // All program output goes through here (so with-output-to-string can capture it).
 void output(std::string_view s);
+// sicm build: every output not captured by with-output-to-string goes to
+// the hook instead of stdout (null: stdout).
+using OutputHook = void (*)(std::string_view s);
+void set_output_hook(OutputHook hook);
+// sicm build: run_source passes each top-level value it prints through this
+// first (null: none), so run-time values can be named in the output.
+using PrintPreparer = Value (*)(Value v);
+void set_print_preparer(PrintPreparer prepare);
+PrintPreparer print_preparer();
 void flush_output();
 int output_column();
 

@@ -272,6 +272,20 @@ struct TailApply {
   return t;
 }
 
+const DynamicBranchHooks *g_dynamic_branch_hooks = nullptr;
+
+Value eval_logic_from(Node *n, uint32_t from, Frame *env) {
+  bool is_and = n->kind == NodeKind::And;
+  for (uint32_t i = from; i < n->nkids; ++i) {
+    Value v = eval(n->kids[i], env);
+    if (i + 1 == n->nkids) return v;
+    if (g_dynamic_branch_hooks && g_dynamic_branch_hooks->dynamic_test(v))
+      return g_dynamic_branch_hooks->logic(v, n, i + 1, is_and, env);
+    if (is_and ? v.is_false() : v.truthy()) return v;
+  }
+  return Value::boolean(is_and);
+}
+
 Value eval(Node *n, Frame *env) {
   check_stack(n->loc);
   for (;;) {
@@ -291,6 +305,7 @@ Value eval(Node *n, Frame *env) {
       Value v = eval(n->kids[0], env);
       Symbol *s = n->value.symbol();
       if (!s->bound) runtime_error(n->loc, "Unbound variable: " + s->name);
+      if (g_dynamic_branch_hooks) g_dynamic_branch_hooks->set_global(s, n->loc);
       s->global = v;
       return Value::unspecified();
     }
@@ -303,6 +318,9 @@ Value eval(Node *n, Frame *env) {
     }
     case NodeKind::If: {
       Value test = eval(n->kids[0], env);
+      if (g_dynamic_branch_hooks && g_dynamic_branch_hooks->dynamic_test(test))
+        return g_dynamic_branch_hooks->branch(test, n->kids[1], n->nkids > 2 ? n->kids[2] : nullptr,
+                                              env);
       if (test.truthy()) {
         n = n->kids[1];
       } else if (n->nkids > 2) {
@@ -326,6 +344,8 @@ Value eval(Node *n, Frame *env) {
       uint32_t i = 0;
       for (; i + 1 < n->nkids; ++i) {
         Value v = eval(n->kids[i], env);
+        if (g_dynamic_branch_hooks && g_dynamic_branch_hooks->dynamic_test(v))
+          return g_dynamic_branch_hooks->logic(v, n, i + 1, is_and, env);
         if (is_and ? v.is_false() : v.truthy()) return v;
       }
       n = n->kids[i];

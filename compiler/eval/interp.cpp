@@ -157,6 +157,7 @@ void run_source(uint32_t file) {
     g_toplevel_loc = f.loc;
     Value v = eval(nodes[i], nullptr);
     if (is_printable_toplevel(f.datum, v)) {
+      if (print_preparer()) v = print_preparer()(v);
       output(write_string(v));
       output("\n");
     }

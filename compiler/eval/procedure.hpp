@@ -91,6 +91,24 @@ Node *analyze_toplevel(Value datum, SrcLoc loc);
 // Evaluate an analyzed node in an environment (null for top level).
 Value eval(Node *node, Frame *env);
 
+// Hooks for `sicm build` (eval/builtins_build.cpp), null otherwise. When a
+// test of if, and, or evaluates to a value that `dynamic_test` accepts (a
+// truth value known only at run time), the evaluator does not choose a
+// branch: `branch` gets the test and both alternatives (else_ may be null)
+// and returns the value that selects between them at run time; `logic`
+// does the same for the rest of an and/or from argument `from` on.
+struct DynamicBranchHooks {
+  bool (*dynamic_test)(Value test);
+  Value (*branch)(Value test, Node *then, Node *else_, Frame *env);
+  Value (*logic)(Value test, Node *n, uint32_t from, bool is_and, Frame *env);
+  // set! of a global while a procedure is traced for run time.
+  void (*set_global)(Symbol *s, SrcLoc loc);
+};
+extern const DynamicBranchHooks *g_dynamic_branch_hooks;
+
+// The and/or node n evaluated from argument `from` on (not a tail call).
+Value eval_logic_from(Node *n, uint32_t from, Frame *env);
+
 // The stack guard: evaluation deeper than the limit raises MIT's
 // "Aborting!: maximum recursion depth exceeded" instead of crashing.
 void set_stack_limit(char *stack_base, size_t usable_bytes);

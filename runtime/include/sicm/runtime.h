@@ -14,6 +14,7 @@
 #include "sicm/min.h"
 #include "sicm/ode.h"
 #include "sicm/quad.h"
+#include "sicm/program.h"
 #include "sicm/root.h"
 
 #ifdef __cplusplus

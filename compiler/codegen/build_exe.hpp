@@ -1,0 +1,27 @@
+// `sicm build` and `sicm emit-c`: a program compiled to C, then to an executable.
+//
+// The program runs once in build mode (eval/build.hpp), which records its
+// residual program; that is emitted as C (codegen/residual_emit.hpp) and
+// compiled with the system C compiler ($CC or cc) against the runtime
+// library, found beside the sicm executable (build tree: build/libsicmrt.a
+// and runtime/include; installed: PREFIX/lib and PREFIX/include).
+#pragma once
+
+#include <string>
+
+namespace sicm {
+
+struct BuildOptions {
+  std::string input;
+  std::string output; // the executable; empty for emit-c
+  std::string opt_level = "-O2";
+  bool keep_c = false;    // leave OUTPUT.c beside the executable
+  bool emit_only = false; // print the C on stdout instead of compiling
+};
+
+// Returns the process exit status (0 on success). Errors in the program
+// propagate as Error (reported by the caller); a failing C compiler is
+// reported here.
+int build_program(const BuildOptions &options);
+
+} // namespace sicm

@@ -1,0 +1,112 @@
+// The residual program: what `sicm build` leaves for run time.
+//
+// The build runs the program in the ordinary evaluator with one difference:
+// numerical primitives do not run. Each leaves a statement here and returns
+// run-time values (dynamic values) of the right shape: fresh uninterned
+// symbols registered as residual variables. Generic arithmetic on them builds
+// expressions, exactly as on the book's literal symbols, so everything the
+// program computes from a dynamic value is an expression over residual
+// variables. What needs a number (a comparison, floor, max, printing) becomes
+// a statement too. Everything else (all symbolic work, all values that do not
+// depend on a numerical result) is done at compile time and appears in the
+// residual program only as the text it prints.
+//
+// The program is a tree of functions. `main` is the top level; a procedure
+// handed to a numerical primitive (an integrand, a system derivative, a
+// monitor) is traced into a function of its own: its arguments are fresh
+// variables, the statements it causes are recorded in its body, its result
+// leaves become its outputs. A function may use variables of the functions
+// that enclose it (an integrand inside an objective uses the objective's
+// argument): those are captured and passed in p[] (see sicm/program.h).
+//
+// Requires: the evaluator running with the hooks of builtins_build.cpp
+// installed. Produces: a ResidualProgram that residual_emit.cpp writes as C.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "algebra/expr.hpp"
+#include "eval/value.hpp"
+#include "syntax/srcloc.hpp"
+
+namespace sicm {
+
+enum class RType : uint8_t { Real, Integer, Boolean };
+
+struct RVar {
+  Symbol *sym;
+  RType type;
+  int id;       // C name "rID"
+  int function; // the function whose body defines it
+};
+
+// A computation that is not an expression of ops.def.
+enum class RCompute : uint8_t {
+  Expr,     // a[0]
+  Less,     // a[0] < a[1]
+  LessEq,   // a[0] <= a[1]
+  Equal,    // a[0] == a[1]
+  Select,   // a[0] != 0 ? a[1] : a[2]
+  Not,      // a[0] == 0
+  Floor,    // floor(a[0])
+  Round,    // round half to even
+  Truncate, // trunc(a[0])
+  Max,      // fmax(a[0], a[1]) (NaN-propagating like MIT's max)
+  Min,
+};
+
+enum class RKind : uint8_t {
+  Text,      // print `text`
+  Let,       // var = compute(args)
+  Print,     // print var (by its type)
+  Frame,     // plot `plot` = frame(args[0..3]) named `text`, titled `title`
+  PlotPoint, // plot-point plot args[0] args[1]
+  PlotLine,  // plot-line plot args[0..3]
+  Close,     // graphics-close plot
+  Integral,  // outs[0] = integral of callee over [args[0], args[1]], tolerance number
+  Minimize,  // outs[0..2] = Brent on callee over [args[0], args[1]], tolerance number
+  Multimin,  // outs = Nelder-Mead of callee from args, tolerance number
+  FindRoot,  // outs[0] = root of callee in [args[0], args[1]], tolerance number
+  Bisect,    // outs[0] = root of callee between args[0], args[1] to args[2]; number n-break
+  Advance,   // outs = state args advanced by args.back() (dt); callee the derivative
+  Evolve,    // outs = final state from args[0..dim) with monitor; dt t_final at the end
+  Fail,      // never reached at compile time; unused for now
+};
+
+struct RStmt {
+  explicit RStmt(RKind k) : kind(k) {}
+  RKind kind;
+  RCompute compute = RCompute::Expr;
+  std::vector<ExprId> args;
+  std::vector<int> outs;                     // variable ids defined by the statement
+  int var = -1;                              // Let, Print
+  int plot = -1;                             // plot statements: the plot's number
+  int callee = -1;                           // the function a numerical statement calls
+  int monitor = -1;                          // Evolve: the monitor function, or -1
+  double number = 0;                         // a tolerance
+  bool time_first = false, rate_one = false; // Advance, Evolve
+  std::string method;                        // Advance, Evolve: the runtime's step type variable
+  std::string text, title;
+  SrcLoc loc; // the call, for run-time errors
+};
+
+struct RFunction {
+  int id;
+  int parent;              // the enclosing function (-1 for main)
+  std::string name;        // the procedure's name, for comments
+  std::vector<int> inputs; // variables bound to in[0..]
+  std::vector<ExprId> outputs;
+  std::vector<RStmt> body;
+  SrcLoc loc;
+};
+
+struct ResidualProgram {
+  std::vector<RFunction> functions; // [0] is main
+  std::vector<RVar> vars;
+  int plots = 0;
+  std::string source_name; // the program's file name, for the executable's --help
+};
+
+} // namespace sicm

@@ -1,0 +1,22 @@
+// The C emitter for whole programs: a ResidualProgram (codegen/residual.hpp)
+// as one C11 translation unit that includes "sicm/runtime.h" and defines
+// main(). Compiles warning-free with -Wall -Wextra.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "codegen/residual.hpp"
+
+namespace sicm {
+
+// Throws a compile Error ("cannot compile: ...") when a run-time value
+// escapes the procedure it was computed in, or a numerical result depends
+// on a symbol or an unknown function.
+std::string emit_residual_program(const ResidualProgram &program);
+
+// s as a C string literal (with the quotes) in which every byte that is not
+// printable ASCII, and " \ ?, is escaped.
+std::string c_string_literal(std::string_view s);
+
+} // namespace sicm

@@ -1,0 +1,1017 @@
+// `sicm build`: the evaluator's primitives and hooks that turn a run into a
+// residual program (see codegen/residual.hpp for the idea).
+//
+// begin_build_mode() rebinds the primitives whose meaning changes: the
+// numerical primitives record a statement and return fresh run-time values;
+// plots record their statements; comparisons, floor, max and min of run-time
+// values become statements; printing names the run-time values it prints.
+// The evaluator's branch hooks make `if`, `and` and `or` on a run-time truth
+// value evaluate both alternatives and select between their values at run
+// time. Everything else runs as it always does, at compile time.
+//
+// What cannot be left for run time is a compile error ("cannot compile")
+// naming the construct, its place in the source, and that `sicm run`
+// interprets it:
+//   - an effect (output, a plot mark, a numerical primitive, set! of a
+//     global) under a test on a run-time value: both alternatives are
+//     evaluated, so an effect would happen whichever way the test goes;
+//   - a loop or recursion whose exit depends on a run-time value (it would
+//     unfold without end; see kMaxBranchDepth);
+//   - set! of a global variable inside a procedure traced for run time (the
+//     procedure runs once at compile time, not each time it is called);
+//   - a run-time value where a static one is needed (a frame's bounds, a
+//     list index) or that escapes the procedure it was computed in.
+#include "eval/build.hpp"
+
+#include <cmath>
+#include <functional>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "algebra/generic.hpp"
+#include "algebra/structure.hpp"
+#include "algebra/symbolic.hpp"
+#include "eval/core.hpp"
+#include "eval/interp.hpp"
+#include "eval/number.hpp"
+#include "eval/numerics_defaults.hpp"
+#include "eval/primitive.hpp"
+#include "eval/procedure.hpp"
+#include "print/printer.hpp"
+
+namespace sicm {
+
+namespace {
+
+// Nested tests on run-time values deeper than this are taken for a loop
+// whose exit depends on a run-time value.
+constexpr int kMaxBranchDepth = 48;
+// Alternatives evaluated under such tests in one top-level form, at most.
+constexpr long kMaxBranchEvaluations = 200000;
+
+const char kMarkerPrefix[] = "__sicm_rt";
+const char kMarkerSuffix[] = "__";
+
+ResidualProgram *g_prog = nullptr;
+std::vector<int> g_open;                    // functions being traced, innermost last
+std::unordered_map<Symbol *, int> g_var_of; // residual variable of a symbol
+int g_branch_depth = 0;
+long g_branch_evaluations = 0;
+
+[[noreturn]] void cannot_compile(SrcLoc loc, const std::string &what) {
+  throw Error(ErrorKind::Syntax, loc, "cannot compile: " + what,
+              "sicm build leaves only numerical work for run time; `sicm run` interprets this "
+              "program");
+}
+
+SrcLoc here() {
+  SrcLoc loc = current_call_loc();
+  return loc.known() ? loc : current_toplevel_loc();
+}
+
+RFunction &current() {
+  return g_prog->functions[g_open.back()];
+}
+
+// ---- run-time values ----------------------------------------------------------------
+
+Value new_var(RType type) {
+  int id = static_cast<int>(g_prog->vars.size());
+  Value sym = make_uninterned_symbol(kMarkerPrefix + std::to_string(id) + kMarkerSuffix);
+  g_prog->vars.push_back(RVar{sym.symbol(), type, id, g_open.back()});
+  g_var_of[sym.symbol()] = id;
+  return sym;
+}
+
+int var_of(Value v) {
+  if (!v.is(Tag::Symbol)) return -1;
+  auto it = g_var_of.find(v.symbol());
+  return it == g_var_of.end() ? -1 : it->second;
+}
+
+// Does the expression mention a residual variable? (Memoized: the arena
+// only grows and nodes never change.)
+bool expr_is_dynamic(ExprId root) {
+  static std::unordered_map<ExprId, bool> memo;
+  auto hit = memo.find(root);
+  if (hit != memo.end()) return hit->second;
+  bool dynamic = false;
+  const ExprNode &n = expr_node(root);
+  switch (n.kind) {
+  case ExprKind::Rational:
+  case ExprKind::Flonum: break;
+  case ExprKind::Symbol: dynamic = g_var_of.count(n.sym) > 0; break;
+  case ExprKind::Apply:
+  case ExprKind::Call: {
+    std::vector<ExprId> args = expr_arg_vector(root);
+    if (n.kind == ExprKind::Call) args.push_back(n.head);
+    for (ExprId a : args)
+      if (expr_is_dynamic(a)) {
+        dynamic = true;
+        break;
+      }
+    break;
+  }
+  }
+  memo[root] = dynamic;
+  return dynamic;
+}
+
+bool is_dynamic_scalar(Value v) {
+  if (var_of(v) >= 0) return true;
+  return v.is(Tag::Expr) && expr_is_dynamic(static_cast<ExprId>(v.i));
+}
+
+bool is_dynamic_boolean(Value v) {
+  int id = var_of(v);
+  return id >= 0 && g_prog->vars[id].type == RType::Boolean;
+}
+
+bool contains_dynamic(Value v) {
+  if (is_dynamic_scalar(v)) return true;
+  if (is_structure(v)) {
+    Structure *s = as_structure(v);
+    for (size_t i = 0; i < s->len; ++i)
+      if (contains_dynamic(s->items[i])) return true;
+    return false;
+  }
+  if (is_pair(v)) return contains_dynamic(car(v)) || contains_dynamic(cdr(v));
+  if (v.is(Tag::Vector)) {
+    Vector *vec = v.vector();
+    for (size_t i = 0; i < vec->len; ++i)
+      if (contains_dynamic(vec->items[i])) return true;
+  }
+  return false;
+}
+
+std::string describe(Value v) {
+  std::string s = write_string(v);
+  if (s.size() > 60) s = s.substr(0, 60) + "...";
+  return s;
+}
+
+// A number, a boolean or a run-time value as an expression node.
+ExprId expr_of(Value v, const char *who) {
+  if (is_number(v)) return expr_from_number(v);
+  if (v.is(Tag::Bool)) return expr_integer(v.truthy() ? 1 : 0);
+  if (var_of(v) >= 0) return expr_symbol(v.symbol());
+  if (v.is(Tag::Expr) && expr_is_dynamic(static_cast<ExprId>(v.i))) return static_cast<ExprId>(v.i);
+  cannot_compile(here(), std::string(who) + " needs a number here, not " + describe(v));
+}
+
+// ---- statements ---------------------------------------------------------------------
+
+bool is_effect(RKind k) {
+  return k != RKind::Let;
+}
+
+void emit(RStmt s) {
+  if (g_branch_depth > 0 && is_effect(s.kind))
+    cannot_compile(here(), "an effect (output, a plot, a numerical primitive) under a test on "
+                           "a value known only at run time");
+  if (!s.loc.known()) s.loc = here();
+  std::vector<RStmt> &body = current().body;
+  if (s.kind == RKind::Text && !body.empty() && body.back().kind == RKind::Text) {
+    body.back().text += s.text;
+    return;
+  }
+  body.push_back(std::move(s));
+}
+
+Value let(RCompute c, std::vector<ExprId> args, RType type) {
+  Value v = new_var(type);
+  RStmt s{RKind::Let};
+  s.compute = c;
+  s.args = std::move(args);
+  s.var = var_of(v);
+  emit(std::move(s));
+  return v;
+}
+
+// A run-time scalar as a variable (an expression gets a Let).
+Value as_var(Value v) {
+  if (var_of(v) >= 0) return v;
+  return let(RCompute::Expr, {expr_of(v, "printing")}, RType::Real);
+}
+
+// ---- output ---------------------------------------------------------------------------
+
+// Output text; names of run-time variables in it (printed from a value
+// prepared by prepare_for_print) become Print statements.
+void residual_output(std::string_view s) {
+  size_t pos = 0;
+  while (pos < s.size()) {
+    size_t m = s.find(kMarkerPrefix, pos);
+    size_t digits = m == std::string_view::npos ? m : m + sizeof kMarkerPrefix - 1;
+    size_t end = digits;
+    while (end != std::string_view::npos && end < s.size() && s[end] >= '0' && s[end] <= '9')
+      ++end;
+    bool marker = m != std::string_view::npos && end > digits &&
+                  s.substr(end, sizeof kMarkerSuffix - 1) == kMarkerSuffix;
+    if (!marker) {
+      size_t stop = m == std::string_view::npos ? s.size() : m + 1;
+      RStmt t{RKind::Text};
+      t.text = std::string(s.substr(pos, stop - pos));
+      emit(std::move(t));
+      pos = stop;
+      continue;
+    }
+    if (m > pos) {
+      RStmt t{RKind::Text};
+      t.text = std::string(s.substr(pos, m - pos));
+      emit(std::move(t));
+    }
+    RStmt p{RKind::Print};
+    p.var = std::stoi(std::string(s.substr(digits, end - digits)));
+    emit(std::move(p));
+    pos = end + sizeof kMarkerSuffix - 1;
+  }
+}
+
+// v with every run-time expression in it replaced by a variable, so that
+// printing it prints variable names (markers) where numbers will be.
+Value prepare_for_print(Value v) {
+  if (is_dynamic_scalar(v)) return as_var(v);
+  if (is_structure(v)) {
+    if (!contains_dynamic(v)) return v;
+    Structure *s = as_structure(v);
+    gcvec<Value> items(s->items, s->items + s->len);
+    for (Value &x : items)
+      x = prepare_for_print(x);
+    return make_structure_from(s->up, items.data(), items.size());
+  }
+  if (is_pair(v)) {
+    if (!contains_dynamic(v)) return v;
+    return cons(prepare_for_print(car(v)), prepare_for_print(cdr(v)));
+  }
+  if (v.is(Tag::Vector) && contains_dynamic(v)) {
+    Vector *vec = v.vector();
+    Value out = make_vector(vec->len, Value::fixnum(0));
+    for (size_t i = 0; i < vec->len; ++i)
+      out.vector()->items[i] = prepare_for_print(vec->items[i]);
+    return out;
+  }
+  return v;
+}
+
+// ---- the primitives that are rebound ---------------------------------------------------
+
+std::unordered_map<std::string, PrimFn> g_original;
+
+PrimFn original(const char *name) {
+  return g_original.at(name);
+}
+
+Value call_original(const char *name, Value *a, int n) {
+  return original(name)(a, n);
+}
+
+// Printing primitives: prepare the value, then print it as always.
+template <const char *Name> Value P_print(Value *a, int n) {
+  gcvec<Value> args(a, a + n);
+  if (n > 0) args[0] = prepare_for_print(args[0]);
+  return call_original(Name, args.data(), n);
+}
+constexpr char kDisplay[] = "display";
+constexpr char kWrite[] = "write";
+constexpr char kWriteLine[] = "write-line";
+constexpr char kPp[] = "pp";
+constexpr char kPrintExpression[] = "print-expression";
+constexpr char kPe[] = "pe";
+
+bool any_dynamic(Value *a, int n) {
+  for (int i = 0; i < n; ++i)
+    if (is_dynamic_scalar(a[i]) || is_dynamic_boolean(a[i])) return true;
+  return false;
+}
+
+// a0 op a1 op a2 ...: the conjunction of the pairwise comparisons.
+Value compare_chain(Value *a, int n, RCompute c, bool swap, const char *who) {
+  Value result = Value::boolean(true);
+  for (int i = 0; i + 1 < n; ++i) {
+    Value x = a[swap ? i + 1 : i], y = a[swap ? i : i + 1];
+    Value r;
+    if (!is_dynamic_scalar(x) && !is_dynamic_scalar(y)) {
+      Value pair[2] = {a[i], a[i + 1]};
+      r = call_original(who, pair, 2);
+    } else {
+      r = let(c, {expr_of(x, who), expr_of(y, who)}, RType::Boolean);
+    }
+    if (i == 0) {
+      result = r;
+    } else if (is_dynamic_boolean(result) || is_dynamic_boolean(r)) {
+      result = let(RCompute::Select, {expr_of(result, who), expr_of(r, who), expr_integer(0)},
+                   RType::Boolean);
+    } else {
+      result = Value::boolean(result.truthy() && r.truthy());
+    }
+  }
+  return result;
+}
+
+template <const char *Name, RCompute C, bool Swap> Value P_compare(Value *a, int n) {
+  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  return compare_chain(a, n, C, Swap, Name);
+}
+constexpr char kLess[] = "<";
+constexpr char kGreater[] = ">";
+constexpr char kLessEq[] = "<=";
+constexpr char kGreaterEq[] = ">=";
+constexpr char kEqual[] = "=";
+
+template <const char *Name, RCompute C, bool Swap> Value P_sign_test(Value *a, int n) {
+  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  Value args[2] = {a[0], Value::fixnum(0)};
+  return compare_chain(args, 2, C, Swap, Name);
+}
+constexpr char kZero[] = "zero?";
+constexpr char kPositive[] = "positive?";
+constexpr char kNegative[] = "negative?";
+
+template <const char *Name, RCompute C> Value P_unary(Value *a, int n) {
+  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  return let(C, {expr_of(a[0], Name)}, RType::Real);
+}
+constexpr char kFloor[] = "floor";
+constexpr char kRound[] = "round";
+constexpr char kTruncate[] = "truncate";
+
+template <const char *Name, RCompute C> Value P_fold(Value *a, int n) {
+  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  Value acc = a[0];
+  for (int i = 1; i < n; ++i)
+    acc = let(C, {expr_of(acc, Name), expr_of(a[i], Name)}, RType::Real);
+  return acc;
+}
+constexpr char kMax[] = "max";
+constexpr char kMin[] = "min";
+
+Value P_not(Value *a, int n) {
+  if (is_dynamic_boolean(a[0])) return let(RCompute::Not, {expr_of(a[0], "not")}, RType::Boolean);
+  return call_original("not", a, n);
+}
+
+// A run-time value is a real number at run time: a flonum, or an exact
+// non-negative integer for a count (minimize's iterations).
+template <const char *Name> Value P_number_test(Value *a, int n) {
+  if (!is_dynamic_scalar(a[0])) return call_original(Name, a, n);
+  int v = var_of(a[0]);
+  bool count = v >= 0 && g_prog->vars[v].type == RType::Integer;
+  std::string_view name = Name;
+  if (name == "number?" || name == "real?") return Value::boolean(true);
+  if (name == "inexact?") return Value::boolean(!count);
+  return Value::boolean(count); // exact?, integer?, exact-integer?, ...
+}
+constexpr char kNumberP[] = "number?";
+constexpr char kRealP[] = "real?";
+constexpr char kInexactP[] = "inexact?";
+constexpr char kExactP[] = "exact?";
+constexpr char kIntegerP[] = "integer?";
+constexpr char kExactIntegerP[] = "exact-integer?";
+constexpr char kExactNonnegP[] = "exact-nonnegative-integer?";
+constexpr char kExactRationalP[] = "exact-rational?";
+
+template <const char *Name> Value P_identity_on_dynamic(Value *a, int n) {
+  if (is_dynamic_scalar(a[0])) return a[0];
+  return call_original(Name, a, n);
+}
+constexpr char kExactToInexact[] = "exact->inexact";
+constexpr char kInexact[] = "inexact";
+
+// ---- states: numbers in nested up/down structures and vectors ----------------------------
+
+// The components of a container (structure or vector), or null.
+Value *container_items(Value v, size_t *len) {
+  if (is_structure(v)) {
+    *len = as_structure(v)->len;
+    return as_structure(v)->items;
+  }
+  if (v.is(Tag::Vector)) {
+    *len = v.vector()->len;
+    return v.vector()->items;
+  }
+  return nullptr;
+}
+
+void state_leaves(Value v, gcvec<Value> &out) {
+  size_t len;
+  Value *items = container_items(v, &len);
+  if (!items) {
+    out.push_back(v);
+    return;
+  }
+  for (size_t i = 0; i < len; ++i)
+    state_leaves(items[i], out);
+}
+
+size_t state_dimension(Value v) {
+  gcvec<Value> leaves;
+  state_leaves(v, leaves);
+  return leaves.size();
+}
+
+// A value shaped like `shape` with leaves taken from *leaves in order.
+Value state_like(Value shape, const Value *&leaves) {
+  size_t len;
+  Value *items = container_items(shape, &len);
+  if (!items) return *leaves++;
+  gcvec<Value> parts;
+  for (size_t i = 0; i < len; ++i)
+    parts.push_back(state_like(items[i], leaves));
+  if (is_structure(shape))
+    return make_structure_from(as_structure(shape)->up, parts.data(), parts.size());
+  Value v = make_vector(parts.size(), Value::fixnum(0));
+  for (size_t i = 0; i < parts.size(); ++i)
+    v.vector()->items[i] = parts[i];
+  return v;
+}
+
+Value state_from_leaves(Value shape, const gcvec<Value> &leaves) {
+  const Value *p = leaves.data();
+  return state_like(shape, p);
+}
+
+// ---- tracing procedures into functions ------------------------------------------------
+
+// Opens a function for the duration of a trace.
+class FunctionScope {
+public:
+  FunctionScope(const std::string &name) {
+    RFunction f;
+    f.id = static_cast<int>(g_prog->functions.size());
+    f.parent = g_open.back();
+    f.name = name;
+    f.loc = here();
+    g_prog->functions.push_back(std::move(f));
+    g_open.push_back(g_prog->functions.back().id);
+    saved_depth_ = g_branch_depth;
+    g_branch_depth = 0; // a test inside the traced procedure is its own
+  }
+  ~FunctionScope() {
+    g_open.pop_back();
+    g_branch_depth = saved_depth_;
+  }
+  int id() const { return g_open.back(); }
+
+private:
+  int saved_depth_;
+};
+
+// A value shaped like `sample` (a number, or an up/down structure of them)
+// whose leaves are fresh inputs of the current function.
+Value input_like(Value sample) {
+  gcvec<Value> leaves;
+  state_leaves(sample, leaves);
+  for (Value &leaf : leaves) {
+    leaf = new_var(RType::Real);
+    current().inputs.push_back(var_of(leaf));
+  }
+  return state_from_leaves(sample, leaves);
+}
+
+bool is_state_shape(Value v) {
+  if (is_number(v) || is_dynamic_scalar(v)) return true;
+  size_t len;
+  Value *items = container_items(v, &len);
+  if (!items || len == 0) return false;
+  for (size_t i = 0; i < len; ++i)
+    if (!is_state_shape(items[i])) return false;
+  return true;
+}
+
+// The result leaves of a traced procedure as outputs, unsimplified: they
+// keep the order of operations the interpreter follows (so a built program
+// computes what `sicm run` computes), and expanding, say, (x - 2)^2 into
+// x^2 - 4x + 4 would lose the accuracy a minimizer near 2 needs.
+void set_outputs(Value result, const char *who) {
+  gcvec<Value> leaves;
+  if (!is_state_shape(result))
+    cannot_compile(here(), std::string("the procedure passed to ") + who + " returns " +
+                               describe(result) + ", not a number or a structure of numbers");
+  state_leaves(result, leaves);
+  for (Value leaf : leaves)
+    current().outputs.push_back(expr_of(leaf, who));
+}
+
+std::string procedure_name(Value proc) {
+  if (proc.is(Tag::Closure) && proc.as<Closure>()->lambda->name)
+    return proc.as<Closure>()->lambda->name->name;
+  return "anonymous";
+}
+
+// Trace a scalar function (integrand, objective, function with a root).
+int trace_scalar(Value f, const char *who) {
+  if (!is_procedure(f)) wrong_type(f, 1, who);
+  FunctionScope scope(procedure_name(f));
+  Value x = input_like(Value::flonum(0));
+  Value r = apply_procedure(f, &x, 1);
+  if (!is_number(r) && !is_dynamic_scalar(r))
+    cannot_compile(here(), std::string("the procedure passed to ") + who + " returns " +
+                               describe(r) + ", not a number");
+  set_outputs(r, who);
+  return scope.id();
+}
+
+// ---- numerical primitives ---------------------------------------------------------------
+
+double static_number(Value *a, int n, int i, double fallback, const char *who) {
+  if (i >= n || a[i].is(Tag::Default)) return fallback;
+  if (!is_number(a[i])) {
+    if (is_dynamic_scalar(a[i]))
+      cannot_compile(here(), std::string(who) + "'s tolerance must be known at compile time");
+    wrong_type(a[i], i + 1, who);
+  }
+  return to_double(a[i]);
+}
+
+ExprId limit_expr(Value v, const char *who) {
+  if (is_symbol(v) && var_of(v) < 0) {
+    const std::string &s = symbol_name(v);
+    if (s == ":+infinity" || s == "+infinity") return expr_flonum(INFINITY);
+    if (s == ":-infinity" || s == "-infinity") return expr_flonum(-INFINITY);
+  }
+  return expr_of(v, who);
+}
+
+Value P_definite_integral(Value *a, int n) {
+  static const char who[] = "definite-integral";
+  if (is_number(a[1]) && is_number(a[2]) && to_double(a[1]) == to_double(a[2]))
+    return Value::fixnum(0); // as the interpreter: an exact 0 over an empty interval
+  RStmt s{RKind::Integral};
+  s.loc = here();
+  s.args = {limit_expr(a[1], who), limit_expr(a[2], who)};
+  s.number = static_number(a, n, 3, kIntegralTolerance, who);
+  s.callee = trace_scalar(a[0], who);
+  Value r = new_var(RType::Real);
+  s.outs = {var_of(r)};
+  emit(std::move(s));
+  return r;
+}
+
+template <const char *Name> Value P_minimize(Value *a, int n) {
+  RStmt s{RKind::Minimize};
+  s.loc = here();
+  s.args = {expr_of(a[1], Name), expr_of(a[2], Name)};
+  s.number = static_number(a, n, 3, kMinimizeTolerance, Name);
+  s.callee = trace_scalar(a[0], Name);
+  Value x = new_var(RType::Real), fx = new_var(RType::Real), it = new_var(RType::Integer);
+  s.outs = {var_of(x), var_of(fx), var_of(it)};
+  emit(std::move(s));
+  return list({x, fx, it});
+}
+constexpr char kMinimize[] = "minimize";
+constexpr char kBrentMin[] = "brent-min";
+
+Value P_multidimensional_minimize(Value *a, int n) {
+  static const char who[] = "multidimensional-minimize";
+  if (!is_procedure(a[0])) wrong_type(a[0], 1, who);
+  bool is_list = !a[1].is(Tag::Vector);
+  gcvec<Value> start;
+  if (is_list) {
+    if (list_length(a[1]) <= 0) wrong_type(a[1], 2, who);
+    start = list_to_vector(a[1]);
+  } else {
+    Vector *v = a[1].vector();
+    start.assign(v->items, v->items + v->len);
+  }
+  if (start.empty()) wrong_type(a[1], 2, who);
+  RStmt s{RKind::Multimin};
+  s.loc = here();
+  for (Value x : start)
+    s.args.push_back(expr_of(x, who));
+  s.number = static_number(a, n, 2, kNelderTolerance, who);
+  {
+    FunctionScope scope(procedure_name(a[0]));
+    gcvec<Value> xs;
+    for (size_t i = 0; i < start.size(); ++i)
+      xs.push_back(input_like(Value::flonum(0)));
+    Value point;
+    if (is_list) {
+      point = list_from(xs.data(), xs.size());
+    } else {
+      point = make_vector(xs.size(), Value::fixnum(0));
+      for (size_t i = 0; i < xs.size(); ++i)
+        point.vector()->items[i] = xs[i];
+    }
+    Value r = apply_procedure(a[0], &point, 1);
+    set_outputs(r, who);
+    if (current().outputs.size() != 1)
+      cannot_compile(here(), "the function passed to multidimensional-minimize must return one "
+                             "number");
+    s.callee = scope.id();
+  }
+  gcvec<Value> result;
+  for (size_t i = 0; i < start.size(); ++i) {
+    Value x = new_var(RType::Real);
+    s.outs.push_back(var_of(x));
+    result.push_back(x);
+  }
+  emit(std::move(s));
+  if (is_list) return list_from(result.data(), result.size());
+  Value v = make_vector(result.size(), Value::fixnum(0));
+  for (size_t i = 0; i < result.size(); ++i)
+    v.vector()->items[i] = result[i];
+  return v;
+}
+
+Value P_find_root(Value *a, int n) {
+  static const char who[] = "find-root";
+  RStmt s{RKind::FindRoot};
+  s.loc = here();
+  s.args = {expr_of(a[1], who), expr_of(a[2], who)};
+  s.number = static_number(a, n, 3, 0.0, who);
+  s.callee = trace_scalar(a[0], who);
+  Value r = new_var(RType::Real);
+  s.outs = {var_of(r)};
+  emit(std::move(s));
+  return r;
+}
+
+Value P_bisect(Value *a, int n) {
+  static const char who[] = "bisect";
+  RStmt s{RKind::Bisect};
+  s.loc = here();
+  s.args = {expr_of(a[1], who), expr_of(a[2], who), expr_of(a[3], who)};
+  s.number = static_number(a, n, 4, kBisectBreak, who);
+  s.callee = trace_scalar(a[0], who);
+  Value r = new_var(RType::Real);
+  s.outs = {var_of(r)};
+  emit(std::move(s));
+  return r;
+}
+
+Value P_not_yet(Value *, int) {
+  cannot_compile(here(), "this numerical primitive is not compiled yet");
+}
+
+// The integrator of argument i (or *ode-integration-method*) as the
+// runtime's step type variable.
+std::string method_of(Value *a, int n, int i, const char *who) {
+  Value m =
+      i < n && !a[i].is(Tag::Default) ? a[i] : intern("*ode-integration-method*").symbol()->global;
+  const char *c = is_symbol(m) ? integrator_c_name(symbol_name(m)) : nullptr;
+  if (!c) {
+    if (i < n) bad_range(a[i], i + 1, who);
+    runtime_error(here(), std::string(who) + ": *ode-integration-method* is " + write_string(m) +
+                              ", which names no integrator");
+  }
+  return c;
+}
+
+// The leaves of a derivative d of a state shaped like `shape`: an exact 0
+// stands for a zero structure of the shape it replaces, as in the
+// interpreter ((up 1 0 0) for the state (up t (up x y) (down px py))).
+bool derivative_leaves(Value d, Value shape, gcvec<Value> &out) {
+  size_t n, m;
+  Value *shape_items = container_items(shape, &n);
+  if (!shape_items) {
+    if (!is_number(d) && !is_dynamic_scalar(d)) return false;
+    out.push_back(d);
+    return true;
+  }
+  if (is_number(d) && is_exact_zero(d)) {
+    for (size_t i = state_dimension(shape); i > 0; --i)
+      out.push_back(d);
+    return true;
+  }
+  Value *d_items = container_items(d, &m);
+  if (!d_items || m != n) return false;
+  for (size_t i = 0; i < n; ++i)
+    if (!derivative_leaves(d_items[i], shape_items[i], out)) return false;
+  return true;
+}
+
+// Trace a system derivative on a state shaped like `state`; fills the
+// statement's callee, time_first and rate_one. The derivative is simplified,
+// as the interpreter's compiled derivatives are (evolve in `sicm run`
+// compiles the same kernel, so both compute the same numbers).
+void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
+  if (!is_state_shape(state)) wrong_type(state, 1, who);
+  FunctionScope scope(procedure_name(sysder));
+  Value x = input_like(state);
+  Value d = apply_procedure(sysder, &x, 1);
+  gcvec<Value> leaves;
+  if (!derivative_leaves(d, state, leaves))
+    cannot_compile(here(), std::string("the system derivative passed to ") + who + " returns " +
+                               describe(d) + ", which is not shaped like the state " +
+                               describe(state));
+  for (Value leaf : leaves)
+    current().outputs.push_back(expr_of(simplify_value(leaf), who));
+  s.callee = scope.id();
+  size_t len;
+  Value *items = container_items(state, &len);
+  s.time_first = items && !container_items(items[0], &len);
+  ExprId d0 = current().outputs[0];
+  s.rate_one =
+      expr_is_exact_one(d0) || (expr_kind(d0) == ExprKind::Flonum && expr_node(d0).d == 1.0);
+}
+
+Value state_result(Value state, RStmt &s) {
+  gcvec<Value> leaves;
+  state_leaves(state, leaves);
+  for (Value &leaf : leaves) {
+    leaf = new_var(RType::Real);
+    s.outs.push_back(var_of(leaf));
+  }
+  return state_from_leaves(state, leaves);
+}
+
+void state_args(Value state, RStmt &s, const char *who) {
+  gcvec<Value> leaves;
+  state_leaves(state, leaves);
+  for (Value leaf : leaves)
+    s.args.push_back(expr_of(leaf, who));
+}
+
+Lambda g_advancer_lambda, g_evolver_lambda;
+
+Value make_named(NativeFn fn, Value sysder, Lambda *lambda) {
+  Value p = make_native_procedure(fn, 0, sysder, Value::nil());
+  static_cast<NativeProc *>(p.as<Opaque>()->obj)->print_as.lambda = lambda;
+  return p;
+}
+
+Value sysder_of(Value *a, int n, const char *who) {
+  if (n < 1 || !is_procedure(a[0])) wrong_type(n < 1 ? Value::nil() : a[0], 1, who);
+  return apply_procedure(a[0], a + 1, n - 1);
+}
+
+Value advance(NativeProc *self, Value *a, int n) {
+  static const char who[] = "state-advancer";
+  if (n < 2 || n > 4) native_arity_error(self, n, 2);
+  RStmt s{RKind::Advance};
+  s.loc = here();
+  s.number = static_number(a, n, 2, kAdvancerTolerance, who);
+  s.method = method_of(a, n, 3, who);
+  state_args(a[0], s, who);
+  s.args.push_back(expr_of(a[1], who));
+  trace_system(self->a, a[0], s, who);
+  Value r = state_result(a[0], s);
+  emit(std::move(s));
+  return r;
+}
+
+Value P_state_advancer(Value *a, int n) {
+  return make_named(advance, sysder_of(a, n, "state-advancer"), &g_advancer_lambda);
+}
+
+Value run_evolve(NativeProc *self, Value *a, int n) {
+  static const char who[] = "evolve";
+  if (n < 4 || n > 6) native_arity_error(self, n, 4);
+  RStmt s{RKind::Evolve};
+  s.loc = here();
+  s.number = static_number(a, n, 4, kAdvancerTolerance, who);
+  s.method = method_of(a, n, 5, who);
+  state_args(a[0], s, who);
+  s.args.push_back(expr_of(a[2], who));
+  s.args.push_back(expr_of(a[3], who));
+  trace_system(self->a, a[0], s, who);
+  Value monitor = a[1];
+  if (!is_procedure(monitor)) wrong_type(monitor, 2, who);
+  {
+    FunctionScope scope(procedure_name(monitor));
+    Value x = input_like(a[0]);
+    apply_procedure(monitor, &x, 1);
+    s.monitor = scope.id();
+  }
+  Value r = state_result(a[0], s);
+  emit(std::move(s));
+  return r;
+}
+
+Value P_evolve(Value *a, int n) {
+  return make_named(run_evolve, sysder_of(a, n, "evolve"), &g_evolver_lambda);
+}
+
+// ---- plots ------------------------------------------------------------------------------
+
+struct BuildPlot {
+  int id;
+  char *name; // GC memory
+};
+
+void write_plot(std::string &out, const void *obj, bool) {
+  out += "#[graphics-device ";
+  out += static_cast<const BuildPlot *>(obj)->name;
+  out += "]";
+}
+
+const OpaqueKind kBuildPlotKind = {"graphics-device", write_plot, nullptr};
+
+BuildPlot *arg_plot(Value *a, int i, const char *who) {
+  if (!a[i].is(Tag::Opaque) || a[i].as<Opaque>()->kind != &kBuildPlotKind)
+    wrong_type(a[i], i + 1, who);
+  return static_cast<BuildPlot *>(a[i].as<Opaque>()->obj);
+}
+
+// The file name the interpreter gives a plot (builtins_plot.cpp).
+std::string plot_file_name(std::string_view title, int number) {
+  std::string name;
+  for (char c : title) {
+    bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                c == '.' || c == '_' || c == '-';
+    name += keep ? c : '-';
+  }
+  while (!name.empty() && (name[0] == '.' || name[0] == '-'))
+    name.erase(0, 1);
+  if (name.size() > 100) name.resize(100);
+  return name.empty() ? "plot-" + std::to_string(number) : name;
+}
+
+Value P_frame(Value *a, int n) {
+  static const char who[] = "frame";
+  RStmt s{RKind::Frame};
+  s.loc = here();
+  double r[4];
+  for (int i = 0; i < 4; ++i) {
+    if (is_dynamic_scalar(a[i]))
+      cannot_compile(here(), "a frame's bounds must be known at compile time");
+    if (!is_number(a[i])) wrong_type(a[i], i + 1, who);
+    r[i] = to_double(a[i]);
+    s.args.push_back(expr_flonum(r[i]));
+  }
+  if (!(r[1] > r[0])) bad_range(a[1], 2, who);
+  if (!(r[3] > r[2])) bad_range(a[3], 4, who);
+  s.plot = ++g_prog->plots;
+  s.title = n > 4 ? std::string(arg_string(a, 4, who)) : "";
+  s.text = plot_file_name(s.title, s.plot);
+  BuildPlot *p = gc_new<BuildPlot>(BuildPlot{s.plot, gc_strdup(s.text)});
+  emit(std::move(s));
+  return Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kBuildPlotKind, p}));
+}
+
+Value P_plot_point(Value *a, int) {
+  RStmt s{RKind::PlotPoint};
+  s.plot = arg_plot(a, 0, "plot-point")->id;
+  s.args = {expr_of(a[1], "plot-point"), expr_of(a[2], "plot-point")};
+  emit(std::move(s));
+  return Value::unspecified();
+}
+
+Value P_plot_line(Value *a, int) {
+  RStmt s{RKind::PlotLine};
+  s.plot = arg_plot(a, 0, "plot-line")->id;
+  for (int i = 1; i <= 4; ++i)
+    s.args.push_back(expr_of(a[i], "plot-line"));
+  emit(std::move(s));
+  return Value::unspecified();
+}
+
+Value P_graphics_close(Value *a, int) {
+  RStmt s{RKind::Close};
+  s.plot = arg_plot(a, 0, "graphics-close")->id;
+  emit(std::move(s));
+  return Value::unspecified();
+}
+
+Value P_graphics_clear(Value *a, int) {
+  arg_plot(a, 0, "graphics-clear");
+  return Value::unspecified();
+}
+
+// ---- branches on run-time values --------------------------------------------------------
+
+// Only a truth value can be false: a run-time number is true, as every number is.
+bool hook_dynamic_test(Value test) {
+  return is_dynamic_boolean(test);
+}
+
+// The value that is `a` when test holds at run time and `b` otherwise.
+Value select_values(Value test, Value a, Value b) {
+  if (eqv(a, b)) return a;
+  bool a_scalar = is_number(a) || a.is(Tag::Bool) || is_dynamic_scalar(a);
+  bool b_scalar = is_number(b) || b.is(Tag::Bool) || is_dynamic_scalar(b);
+  if (a_scalar && b_scalar) {
+    bool boolean =
+        (a.is(Tag::Bool) || is_dynamic_boolean(a)) && (b.is(Tag::Bool) || is_dynamic_boolean(b));
+    return let(RCompute::Select, {expr_of(test, "if"), expr_of(a, "if"), expr_of(b, "if")},
+               boolean ? RType::Boolean : RType::Real);
+  }
+  if (is_structure(a) && is_structure(b) && as_structure(a)->up == as_structure(b)->up &&
+      as_structure(a)->len == as_structure(b)->len) {
+    Structure *x = as_structure(a), *y = as_structure(b);
+    gcvec<Value> items;
+    for (size_t i = 0; i < x->len; ++i)
+      items.push_back(select_values(test, x->items[i], y->items[i]));
+    return make_structure_from(x->up, items.data(), items.size());
+  }
+  if (is_pair(a) && is_pair(b))
+    return cons(select_values(test, car(a), car(b)), select_values(test, cdr(a), cdr(b)));
+  cannot_compile(here(), "the alternatives of a test on a value known only at run time give " +
+                             describe(a) + " and " + describe(b) +
+                             ", which cannot be chosen between at run time");
+}
+
+// Evaluate one alternative under a run-time test.
+Value speculate(const std::function<Value()> &alternative) {
+  if (g_branch_depth >= kMaxBranchDepth || ++g_branch_evaluations > kMaxBranchEvaluations)
+    cannot_compile(here(), "a loop or recursion whose end depends on a value known only at run "
+                           "time");
+  ++g_branch_depth;
+  try {
+    Value v = alternative();
+    --g_branch_depth;
+    return v;
+  } catch (...) {
+    --g_branch_depth;
+    throw;
+  }
+}
+
+Value hook_branch(Value test, Node *then, Node *else_, Frame *env) {
+  Value a = speculate([&] { return eval(then, env); });
+  Value b = speculate([&] { return else_ ? eval(else_, env) : Value::unspecified(); });
+  return select_values(test, a, b);
+}
+
+Value hook_logic(Value test, Node *n, uint32_t from, bool is_and, Frame *env) {
+  Value rest = speculate([&] { return eval_logic_from(n, from, env); });
+  return is_and ? select_values(test, rest, Value::boolean(false))
+                : select_values(test, Value::boolean(true), rest);
+}
+
+void hook_set_global(Symbol *s, SrcLoc loc) {
+  if (g_open.size() > 1)
+    cannot_compile(loc, "set! of the global variable " + s->name +
+                            " inside a procedure that runs at run time (it is traced once, "
+                            "at compile time)");
+}
+
+const DynamicBranchHooks kHooks = {hook_dynamic_test, hook_branch, hook_logic, hook_set_global};
+
+void rebind(const char *name, int min, int max, PrimFn fn) {
+  Symbol *s = intern(name).symbol();
+  if (s->bound && s->global.is(Tag::Primitive)) g_original[name] = s->global.as<Primitive>()->fn;
+  define_primitive(name, min, max, fn);
+}
+
+Value prepare_toplevel(Value v) {
+  return prepare_for_print(v);
+}
+
+} // namespace
+
+void begin_build_mode(ResidualProgram *program) {
+  g_prog = program;
+  RFunction main_fn;
+  main_fn.id = 0;
+  main_fn.parent = -1;
+  main_fn.name = "main";
+  program->functions.push_back(std::move(main_fn));
+  g_open = {0};
+  g_advancer_lambda.name = intern("state-advancer").symbol();
+  g_evolver_lambda.name = intern("evolve").symbol();
+
+  rebind("display", 1, 2, P_print<kDisplay>);
+  rebind("write", 1, 2, P_print<kWrite>);
+  rebind("write-line", 1, 2, P_print<kWriteLine>);
+  rebind("pp", 1, 2, P_print<kPp>);
+  rebind("print-expression", 1, 1, P_print<kPrintExpression>);
+  rebind("pe", 1, 1, P_print<kPe>);
+  rebind("<", 1, kVariadic, P_compare<kLess, RCompute::Less, false>);
+  rebind(">", 1, kVariadic, P_compare<kGreater, RCompute::Less, true>);
+  rebind("<=", 1, kVariadic, P_compare<kLessEq, RCompute::LessEq, false>);
+  rebind(">=", 1, kVariadic, P_compare<kGreaterEq, RCompute::LessEq, true>);
+  rebind("=", 1, kVariadic, P_compare<kEqual, RCompute::Equal, false>);
+  rebind("zero?", 1, 1, P_sign_test<kZero, RCompute::Equal, false>);
+  rebind("positive?", 1, 1, P_sign_test<kPositive, RCompute::Less, true>);
+  rebind("negative?", 1, 1, P_sign_test<kNegative, RCompute::Less, false>);
+  rebind("floor", 1, 1, P_unary<kFloor, RCompute::Floor>);
+  rebind("round", 1, 1, P_unary<kRound, RCompute::Round>);
+  rebind("truncate", 1, 1, P_unary<kTruncate, RCompute::Truncate>);
+  rebind("max", 1, kVariadic, P_fold<kMax, RCompute::Max>);
+  rebind("min", 1, kVariadic, P_fold<kMin, RCompute::Min>);
+  rebind("not", 1, 1, P_not);
+  rebind("number?", 1, 1, P_number_test<kNumberP>);
+  rebind("real?", 1, 1, P_number_test<kRealP>);
+  rebind("inexact?", 1, 1, P_number_test<kInexactP>);
+  rebind("exact?", 1, 1, P_number_test<kExactP>);
+  rebind("integer?", 1, 1, P_number_test<kIntegerP>);
+  rebind("exact-integer?", 1, 1, P_number_test<kExactIntegerP>);
+  rebind("exact-nonnegative-integer?", 1, 1, P_number_test<kExactNonnegP>);
+  rebind("exact-rational?", 1, 1, P_number_test<kExactRationalP>);
+  rebind("exact->inexact", 1, 1, P_identity_on_dynamic<kExactToInexact>);
+  rebind("inexact", 1, 1, P_identity_on_dynamic<kInexact>);
+
+  rebind("definite-integral", 3, 5, P_definite_integral);
+  rebind("minimize", 3, 4, P_minimize<kMinimize>);
+  rebind("brent-min", 3, 4, P_minimize<kBrentMin>);
+  rebind("multidimensional-minimize", 2, 3, P_multidimensional_minimize);
+  rebind("find-root", 3, 4, P_find_root);
+  rebind("nelder-mead", 2, 5, P_not_yet);
+  rebind("bisect", 4, 5, P_bisect);
+  rebind("state-advancer", 1, kVariadic, P_state_advancer);
+  rebind("evolve", 1, kVariadic, P_evolve);
+  rebind("frame", 4, 5, P_frame);
+  rebind("plot-point", 3, 3, P_plot_point);
+  rebind("plot-line", 5, 5, P_plot_line);
+  rebind("graphics-close", 1, 1, P_graphics_close);
+  rebind("graphics-clear", 1, 1, P_graphics_clear);
+
+  set_output_hook(residual_output);
+  set_print_preparer(prepare_toplevel);
+  g_dynamic_branch_hooks = &kHooks;
+}
+
+} // namespace sicm

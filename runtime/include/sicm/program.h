@@ -1,0 +1,132 @@
+/* sicm runtime: what the executables made by `sicm build` call.
+ *
+ * `sicm build` turns a program into C: the values known at compile time are
+ * printed from constants, the procedures handed to numerical primitives
+ * become kernels (functions with the kernel ABI below), and each call of a
+ * numerical primitive becomes one call of a sicm_drive_* function here. The
+ * drivers give the primitives the same meaning as the interpreter gives them
+ * (the same defaults, integrator restarts, monitor times, tolerance
+ * relaxation), so a built program prints what `sicm run` prints.
+ *
+ * Failures do not return: a driver that cannot do its job prints the error
+ * in the compiler's style, naming the source position of the call, the
+ * primitive and the reason, finishes every plot (so no point is lost) and
+ * exits with status 70, as `sicm run` does. */
+#ifndef SICM_PROGRAM_H
+#define SICM_PROGRAM_H
+
+#include <stddef.h>
+
+#include "sicm/ode.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sicm_plot sicm_plot; /* runtime.h */
+
+/* The kernel ABI: in[] the arguments' scalar leaves, out[] the result's
+ * leaves, p[] values the kernel captures from the code that calls it (run-time
+ * values of the enclosing procedure). A kernel with no result may be given a
+ * NULL out. */
+typedef void (*sicm_kernel_fn)(const double *in, double *out, const double *p);
+
+/* A kernel with its captured values. */
+typedef struct {
+  sicm_kernel_fn fn;
+  const double *p;
+} sicm_closure;
+
+/* Where a primitive was called in the source: "FILE:LINE:COL", the text of
+ * that line and the column (1-based) of the call, for error messages. */
+typedef struct {
+  const char *where;
+  const char *line;
+  int col;
+} sicm_site;
+
+/* sicm_program_init reads the executable's options (--plot-dir DIR, --help),
+ * exiting with status 64 and a usage line for anything else, and arranges
+ * for plots to be finished at exit and on SIGINT/SIGTERM. Call first. */
+void sicm_program_init(int argc, char **argv, const char *program_name);
+
+/* sicm_program_fail prints "WHERE: error: WHO: REASON", the source line and
+ * a caret on stderr, finishes every plot and exits with status 70. */
+void sicm_program_fail(const sicm_site *site, const char *who, const char *reason)
+#if defined(__GNUC__)
+    __attribute__((noreturn))
+#endif
+    ;
+
+/* Printing, as the compiler prints: text as it is, a real in MIT Scheme's
+ * shortest round-trip form ("435.", ".5", "-1.5e-14"), an integer (given as
+ * a double with an integral value) in decimal, a boolean (0 or not) as #f or
+ * #t. */
+void sicm_print_text(const char *s);
+void sicm_print_real(double x);
+void sicm_print_integer(double x);
+void sicm_print_boolean(double x);
+
+/* (frame xmin xmax ymin ymax [title]) and the marks added to it; a plot file
+ * that cannot be created or written is a failure at `site`. NAME is the file
+ * name without extension, TITLE may be NULL. */
+sicm_plot *sicm_program_frame(const sicm_site *site, const char *name, const char *title,
+                              double xmin, double xmax, double ymin, double ymax);
+void sicm_program_plot_point(const sicm_site *site, sicm_plot *plot, double x, double y);
+void sicm_program_plot_line(const sicm_site *site, sicm_plot *plot, double x0, double y0, double x1,
+                            double y1);
+
+/* (definite-integral f a b tol): f's integral over [a, b] to the relative
+ * tolerance tol, by adaptive Gauss-Kronrod; when a purely relative tolerance
+ * cannot be met because the integral is much smaller than the integral of
+ * |f|, the tolerance is taken relative to the latter (as the interpreter
+ * does). Infinite limits are allowed. */
+double sicm_drive_integral(const sicm_site *site, sicm_closure f, double a, double b, double tol);
+
+/* (minimize f a b tol): Brent's method; out = {argument, value, iterations}. */
+void sicm_drive_minimize(const sicm_site *site, sicm_closure f, double a, double b, double tol,
+                         double out[3]);
+
+/* (multidimensional-minimize f x tol): Nelder-Mead from x (n values), which
+ * receives the minimizing point. The kernel takes the n coordinates. */
+void sicm_drive_multimin(const sicm_site *site, sicm_closure f, size_t n, double *x, double tol);
+
+/* (find-root f a b tol): a root of f in [a, b] by Brent's method; the ends
+ * must bracket a root. */
+double sicm_drive_find_root(const sicm_site *site, sicm_closure f, double a, double b, double tol);
+
+/* (bisect f x0 x1 eps n-break): a root of f between x0 and x1 by bisection
+ * (then, after n_break halvings, by false position) until the ends are
+ * close to eps in scmutils' close-enuf? sense. */
+double sicm_drive_bisect(const sicm_site *site, sicm_closure f, double x0, double x1, double eps,
+                         long n_break);
+
+/* An ODE problem: the system derivative maps a state of dim leaves to its
+ * derivative. time_first: the state's first leaf is the time; rate_one: its
+ * derivative is exactly 1, so the state reported at output time t carries
+ * exactly t. */
+typedef struct {
+  const sicm_ode_step_type *method;
+  sicm_closure sysder;
+  size_t dim;
+  int time_first;
+  int rate_one;
+  double tol;
+} sicm_drive_ode;
+
+/* ((state-advancer ...) state dt tol): y (dim leaves) becomes the state dt
+ * later. */
+void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double *y, double dt);
+
+/* ((evolve ...) state monitor dt t-final tol): calls monitor (a kernel of
+ * the state, NULL fn for none) at the initial state and every dt until
+ * t-final (the last interval shortened to end there); y becomes the final
+ * state. */
+void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure monitor,
+                       double *y, double dt, double t_final);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SICM_PROGRAM_H */

@@ -1,0 +1,342 @@
+/* What built programs call: options, printing, plots and the numerical
+ * primitives' drivers (see sicm/program.h).
+ *
+ * Each driver mirrors the interpreter's primitive of the same name
+ * (compiler/eval/builtins_numerics.cpp): the same defaults, the same way of
+ * restarting integrators and of placing monitor times, the same relaxation
+ * of an integral's tolerance. Kernels are adapted to the runtime's callback
+ * types by the small functions below; the runtime's error hook records the
+ * last failure message so the driver can quote it. */
+#include <errno.h>
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sicm/runtime.h"
+
+/* ---- options and failure --------------------------------------------------------- */
+
+static const char *plot_dir = ".";
+static char last_reason[1024];
+
+static void record_reason(const char *reason, int status) {
+  (void)status;
+  snprintf(last_reason, sizeof last_reason, "%s", reason);
+}
+
+/* The runtime's message without its "sicm_function_name: " prefix. */
+static const char *reason_text(void) {
+  const char *colon = strstr(last_reason, ": ");
+  if (strncmp(last_reason, "sicm_", 5) == 0 && colon) return colon + 2;
+  return last_reason[0] ? last_reason : "failed";
+}
+
+void sicm_program_init(int argc, char **argv, const char *program_name) {
+  for (int i = 1; i < argc; ++i) {
+    if (strcmp(argv[i], "--plot-dir") == 0 && i + 1 < argc) {
+      plot_dir = argv[++i];
+    } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+      printf("usage: %s [--plot-dir DIR]\n"
+             "  a program compiled by sicm build from %s; plots go to DIR (default .)\n",
+             argv[0], program_name);
+      exit(0);
+    } else {
+      fprintf(stderr, "usage: %s [--plot-dir DIR]\n", argv[0]);
+      exit(64);
+    }
+  }
+  sicm_set_error_handler(record_reason);
+}
+
+void sicm_program_fail(const sicm_site *site, const char *who, const char *reason) {
+  fflush(stdout);
+  fprintf(stderr, "%s: error: %s: %s\n", site->where, who, reason);
+  if (site->line && site->line[0]) {
+    fprintf(stderr, "  %s\n  ", site->line);
+    for (int i = 1; i < site->col; ++i)
+      fputc(site->line[i - 1] == '\t' ? '\t' : ' ', stderr);
+    fputs("^\n", stderr);
+  }
+  sicm_plot_close_all();
+  exit(70);
+}
+
+/* ---- printing --------------------------------------------------------------------- */
+
+void sicm_print_text(const char *s) {
+  fputs(s, stdout);
+}
+
+void sicm_print_real(double x) {
+  char buf[SICM_DOUBLE_BUFSIZE];
+  sicm_format_double(buf, x);
+  fputs(buf, stdout);
+}
+
+void sicm_print_integer(double x) {
+  printf("%.0f", x);
+}
+
+void sicm_print_boolean(double x) {
+  fputs(x != 0 ? "#t" : "#f", stdout);
+}
+
+/* ---- plots ------------------------------------------------------------------------- */
+
+sicm_plot *sicm_program_frame(const sicm_site *site, const char *name, const char *title,
+                              double xmin, double xmax, double ymin, double ymax) {
+  sicm_plot *p = sicm_plot_open(plot_dir, name, title, xmin, xmax, ymin, ymax);
+  if (!p) {
+    char reason[512];
+    snprintf(reason, sizeof reason, "cannot create the plot file %s/%s.tsv: %s", plot_dir, name,
+             strerror(errno));
+    sicm_program_fail(site, "frame", reason);
+  }
+  return p;
+}
+
+void sicm_program_plot_point(const sicm_site *site, sicm_plot *plot, double x, double y) {
+  if (sicm_plot_point(plot, x, y) != 0)
+    sicm_program_fail(site, "plot-point", "the plot is closed or memory is exhausted");
+}
+
+void sicm_program_plot_line(const sicm_site *site, sicm_plot *plot, double x0, double y0, double x1,
+                            double y1) {
+  if (sicm_plot_line(plot, x0, y0, x1, y1) != 0)
+    sicm_program_fail(site, "plot-line", "the plot is closed or memory is exhausted");
+}
+
+/* ---- kernels as the runtime's callbacks -------------------------------------------- */
+
+static double scalar_of(double x, void *c) {
+  const sicm_closure *k = c;
+  double out;
+  k->fn(&x, &out, k->p);
+  return out;
+}
+
+static double abs_scalar_of(double x, void *c) {
+  return fabs(scalar_of(x, c));
+}
+
+static double vector_of(const double *x, void *c) {
+  const sicm_closure *k = c;
+  double out;
+  k->fn(x, &out, k->p);
+  return out;
+}
+
+static int rhs_of(double t, const double *y, double *dydt, void *c) {
+  (void)t;
+  const sicm_closure *k = c;
+  k->fn(y, dydt, k->p);
+  return 0;
+}
+
+static void fail_with_status(const sicm_site *site, const char *who) {
+  sicm_program_fail(site, who, reason_text());
+}
+
+/* ---- quadrature, minimization, roots ------------------------------------------------- */
+
+double sicm_drive_integral(const sicm_site *site, sicm_closure f, double a, double b, double tol) {
+  static const char who[] = "definite-integral";
+  if (a == b) return 0.0;
+  double result = 0;
+  int status = sicm_quad_integrate(scalar_of, &f, a, b, tol, &result);
+  if (status == SICM_ETOL) {
+    /* As the interpreter: a relative test cannot be met when the integral is
+     * much smaller than the integral of |f| (cancellation); then take the
+     * tolerance relative to the latter and integrate again. */
+    char message[sizeof last_reason];
+    memcpy(message, last_reason, sizeof message);
+    double magnitude = 0;
+    int s2 = sicm_quad_integrate(abs_scalar_of, &f, a, b, 1e-3, &magnitude);
+    if (s2 == SICM_SUCCESS && magnitude > 2 * fabs(result)) {
+      if (result == 0) return 0.0;
+      double relaxed = tol * magnitude / fabs(result);
+      status = sicm_quad_integrate(scalar_of, &f, a, b, relaxed, &result);
+      if (status == SICM_SUCCESS) return result;
+    }
+    memcpy(last_reason, message, sizeof message);
+  }
+  if (status != SICM_SUCCESS) fail_with_status(site, who);
+  return result;
+}
+
+void sicm_drive_minimize(const sicm_site *site, sicm_closure f, double a, double b, double tol,
+                         double out[3]) {
+  if (a == b) sicm_program_fail(site, "minimize", "the interval is empty");
+  if (a > b) {
+    double t = a;
+    a = b;
+    b = t;
+  }
+  double x = 0, fx = 0;
+  int iterations = 0;
+  if (sicm_min_brent(scalar_of, &f, a, b, tol, &x, &fx, &iterations) != SICM_SUCCESS)
+    fail_with_status(site, "minimize");
+  out[0] = x;
+  out[1] = fx;
+  out[2] = iterations;
+}
+
+void sicm_drive_multimin(const sicm_site *site, sicm_closure f, size_t n, double *x, double tol) {
+  enum { kMaxIterations = 20000 }; /* the interpreter's 20 * nelder-maxiter */
+  const double start_step = 0.01;  /* nelder-start-step */
+  double fmin = 0;
+  int iterations = 0;
+  int status = sicm_min_nelder_mead(vector_of, &f, n, x, start_step, tol, kMaxIterations, &fmin,
+                                    &iterations);
+  if (status == SICM_EMAXITER) {
+    char reason[256];
+    snprintf(reason, sizeof reason, "the minimizer did not converge in %d iterations", iterations);
+    sicm_program_fail(site, "multidimensional-minimize", reason);
+  }
+  if (status != SICM_SUCCESS) fail_with_status(site, "multidimensional-minimize");
+}
+
+double sicm_drive_find_root(const sicm_site *site, sicm_closure f, double a, double b, double tol) {
+  static const char who[] = "find-root";
+  if (a > b) {
+    double t = a;
+    a = b;
+    b = t;
+  }
+  if (a == b) sicm_program_fail(site, who, "the interval is empty");
+  double fa = scalar_of(a, &f), fb = scalar_of(b, &f);
+  if (fa == 0) return a;
+  if (fb == 0) return b;
+  if (isfinite(fa) && isfinite(fb) && (fa > 0) == (fb > 0)) {
+    char reason[256], sa[SICM_DOUBLE_BUFSIZE], sb[SICM_DOUBLE_BUFSIZE];
+    char xa[SICM_DOUBLE_BUFSIZE], xb[SICM_DOUBLE_BUFSIZE];
+    sicm_format_double(sa, fa);
+    sicm_format_double(sb, fb);
+    sicm_format_double(xa, a);
+    sicm_format_double(xb, b);
+    snprintf(reason, sizeof reason,
+             "the function is %s at %s and %s at %s: the interval does not bracket a root", sa, xa,
+             sb, xb);
+    sicm_program_fail(site, who, reason);
+  }
+  double root = 0;
+  if (sicm_root_brent(scalar_of, &f, a, b, tol, &root) != SICM_SUCCESS) fail_with_status(site, who);
+  return root;
+}
+
+/* scmutils' close-enuf?: |x - y| <= tol/2 (|x| + |y| + 2), tol at least the
+ * machine epsilon. */
+static int close_enough(double x, double y, double tol) {
+  return fabs(x - y) <= 0.5 * fmax(tol, DBL_EPSILON) * (fabs(x) + fabs(y) + 2);
+}
+
+static int sign_of(double v) {
+  return v > 0 ? 1 : v < 0 ? -1 : 0;
+}
+
+double sicm_drive_bisect(const sicm_site *site, sicm_closure f, double x0, double x1, double eps,
+                         long n_break) {
+  static const char who[] = "bisect";
+  enum { kMaxIterations = 10000 };
+  double f0 = scalar_of(x0, &f), f1 = scalar_of(x1, &f);
+  char reason[256], a[SICM_DOUBLE_BUFSIZE], b[SICM_DOUBLE_BUFSIZE];
+  for (long iter = 0;; ++iter) {
+    if (f0 == 0) return x0;
+    if (f1 == 0) return x1;
+    if (sign_of(f0) * sign_of(f1) > 0 || isnan(f0) || isnan(f1)) {
+      char fa[SICM_DOUBLE_BUFSIZE], fb[SICM_DOUBLE_BUFSIZE];
+      sicm_format_double(fa, f0);
+      sicm_format_double(fb, f1);
+      sicm_format_double(a, x0);
+      sicm_format_double(b, x1);
+      snprintf(reason, sizeof reason, "root not bounded: the function is %s at %s and %s at %s", fa,
+               a, fb, b);
+      sicm_program_fail(site, who, reason);
+    }
+    double xm = iter < n_break ? (x0 + x1) / 2 : (f1 * x0 - f0 * x1) / (f1 - f0);
+    if (close_enough(x0, x1, eps)) return xm;
+    if (iter >= kMaxIterations) {
+      sicm_format_double(a, x0);
+      sicm_format_double(b, x1);
+      snprintf(reason, sizeof reason,
+               "no convergence in %d iterations; the root is between %s and %s",
+               (int)kMaxIterations, a, b);
+      sicm_program_fail(site, who, reason);
+    }
+    double fm = scalar_of(xm, &f);
+    if (sign_of(f1) * sign_of(fm) < 0) {
+      x0 = xm;
+      f0 = fm;
+    } else {
+      x1 = xm;
+      f1 = fm;
+    }
+  }
+}
+
+/* ---- ordinary differential equations ------------------------------------------------- */
+
+typedef struct {
+  sicm_ode *o;
+  sicm_closure sysder;
+} integrator;
+
+static void open_integrator(const sicm_site *site, const char *who, const sicm_drive_ode *ode,
+                            integrator *it) {
+  it->sysder = ode->sysder;
+  it->o = sicm_ode_alloc(ode->method, ode->dim, rhs_of, &it->sysder, ode->tol, ode->tol);
+  if (!it->o) fail_with_status(site, who);
+}
+
+static void evolve_to(const sicm_site *site, const char *who, integrator *it, double *t, double t1,
+                      double *y) {
+  if (sicm_ode_evolve(it->o, t, t1, y) != SICM_SUCCESS) {
+    snprintf(last_reason, sizeof last_reason, "%s", sicm_ode_last_error(it->o));
+    sicm_ode_free(it->o);
+    fail_with_status(site, who);
+  }
+}
+
+static double start_time(const sicm_drive_ode *ode, const double *y) {
+  return ode->time_first && isfinite(y[0]) ? y[0] : 0.0;
+}
+
+void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double *y, double dt) {
+  static const char who[] = "state-advancer";
+  integrator it;
+  open_integrator(site, who, ode, &it);
+  double t = start_time(ode, y), t1 = t + dt;
+  evolve_to(site, who, &it, &t, t1, y);
+  if (ode->time_first && ode->rate_one) y[0] = t1;
+  sicm_ode_free(it.o);
+}
+
+void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure monitor,
+                       double *y, double dt, double t_final) {
+  static const char who[] = "evolve";
+  const double t0 = start_time(ode, y);
+  if (dt == 0 && t_final != t0) sicm_program_fail(site, who, "the step between monitor calls is 0");
+  const double step = fabs(dt) * (t_final >= t0 ? 1.0 : -1.0);
+  const double near_end = 1e-9 * fabs(step);
+  double *shown = malloc(ode->dim * sizeof *shown);
+  if (!shown) sicm_program_fail(site, who, "out of memory");
+  if (monitor.fn) monitor.fn(y, NULL, monitor.p);
+  integrator it;
+  open_integrator(site, who, ode, &it);
+  double t = t0;
+  for (long k = 1; fabs(t_final - t) > 0; ++k) {
+    double tk = t0 + (double)k * step;
+    if ((step > 0 ? t_final - tk : tk - t_final) <= near_end) tk = t_final;
+    evolve_to(site, who, &it, &t, tk, y);
+    if (monitor.fn) {
+      memcpy(shown, y, ode->dim * sizeof *shown);
+      if (ode->time_first && ode->rate_one) shown[0] = tk;
+      monitor.fn(shown, NULL, monitor.p);
+    }
+  }
+  if (ode->time_first && ode->rate_one) y[0] = t_final;
+  sicm_ode_free(it.o);
+  free(shown);
+}
