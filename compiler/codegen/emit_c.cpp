@@ -17,7 +17,8 @@
 //
 // Numbers are emitted as the double they round to (exact rationals correctly
 // rounded), in the shortest form that reads back exactly. No user text
-// reaches the C: inputs are in[i], temporaries tN, and names are sanitized.
+// reaches the C: inputs are in[i], temporaries tN, and names are sanitized
+// (and, by c_kernel_name, kept distinct). No string literal is ever emitted.
 #include "codegen/emit_c.hpp"
 
 #include <algorithm>
@@ -28,6 +29,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "codegen/jit.hpp"
 #include "eval/number.hpp"
 #include "sicm/runtime.h"
 
@@ -358,6 +360,49 @@ std::string c_sanitize(std::string_view s, size_t max_len) {
     out += ok ? ch : '_';
   }
   return out.empty() ? "anonymous" : out;
+}
+
+namespace {
+
+// c_kernel_name's bounds: a name is kept as it is up to kReadableMax bytes,
+// and a hashed one keeps that much of itself, sanitized, before its hash.
+constexpr size_t kReadableMax = 40;
+constexpr size_t kHashDigits = 16;
+
+bool is_identifier_tail(std::string_view s) {
+  for (char ch : s)
+    if (!((ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+          ch == '_'))
+      return false;
+  return true;
+}
+
+// Does s end as c_kernel_name's hashed form does: "_h" and kHashDigits
+// lowercase hex digits?
+bool looks_hashed(std::string_view s) {
+  if (s.size() < kHashDigits + 2) return false;
+  std::string_view tail = s.substr(s.size() - kHashDigits - 2);
+  return tail.substr(0, 2) == "_h" &&
+         tail.find_first_not_of("0123456789abcdef", 2) == std::string_view::npos;
+}
+
+} // namespace
+
+// The C name of the kernel for the procedure named `name`: "sicm_kernel_"
+// and the name itself if it is a short C identifier tail, else the name
+// sanitized and cut, "_h" and 16 hex digits of its SHA-256. c_sanitize alone
+// is not one-to-one (x-y, x_y and x?y all give x_y; long names lose their
+// ends), so two kernels in one translation unit (`sicm emit-c`) could clash.
+// Here the two forms cannot meet, since a kept name never ends like a hashed
+// one, and hashed ones differ in their hash unless SHA-256 collides in 64
+// bits; the result is at most 12 + 40 + 2 + 16 = 70 bytes. The prefix keeps
+// every result clear of C keywords, `main` and reserved identifiers.
+std::string c_kernel_name(std::string_view name) {
+  std::string out = "sicm_kernel_";
+  if (!name.empty() && name.size() <= kReadableMax && is_identifier_tail(name) &&
+      !looks_hashed(name))
+    return out.append(name);
+  return out + c_sanitize(name, kReadableMax) + "_h" + jit_hash(name).substr(0, kHashDigits);
 }
 
 std::string c_double_literal(double d) {

@@ -1,24 +1,35 @@
-// The JIT: C source to a loaded shared object through the system C compiler, cached by content hash.
+// The JIT: C source to a loaded shared object by the system C compiler, cached by content hash.
 //
 // The compiler is $CC (split on blanks) or `cc`, run without a shell as
 //   CC -std=c11 -O2 -fPIC -shared -o OUT.so SRC.c -lm
 // (no -ffast-math: kernels keep IEEE semantics). Objects are cached in
 // $XDG_CACHE_HOME/sicm, else ~/.cache/sicm, else a private temporary
-// directory, under a 128-bit hash of the source and the command line, so an
-// unchanged kernel is compiled once per machine. Files are written under
-// temporary names and renamed into place: concurrent runs never load half a
-// file. Loaded objects stay loaded for the life of the process.
+// directory, as KEY.so where KEY is the SHA-256 of the source, the compiler
+// command and the machine, so an unchanged kernel is compiled once per
+// machine. The cache is trusted only as far as it is checked:
+//   - the directory must be owned by this user and writable by no one else
+//     (else the private temporary directory is used, with a note on stderr);
+//   - a KEY.so is loaded only if it is a regular file (not a symbolic link)
+//     owned by this user, writable by no one else, and ends in a trailer that
+//     this code appended when it built the object: the full key and the
+//     SHA-256 of every byte before the trailer, both of which must match;
+//   - anything else (missing, truncated, corrupt, planted, written by an older
+//     sicm, or refused by dlopen) is rebuilt once, then loaded.
+// Objects are compiled under unique temporary names and renamed into place,
+// so concurrent runs never see half a file. Loaded objects stay loaded for
+// the life of the process. docs/reliability.md gives the reasons.
 #pragma once
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 namespace sicm {
 
 // Compile (or find in the cache) `c_source`, load it and return the address
 // of `symbol` in it. On failure returns null and a one-line reason (with the
 // start of the compiler's diagnostics) in *why_not. *so_path, if not null,
-// receives the shared object's path.
+// receives the shared object's path. Thread-safe.
 void *jit_load(const std::string &c_source, const std::string &symbol, std::string *so_path,
                std::string *why_not);
 
@@ -29,7 +40,10 @@ uint64_t jit_compiler_runs();
 // The cache directory jit_load would use now (created if missing).
 std::string jit_cache_dir();
 
-// The 128-bit content hash the cache uses, as 32 hex digits.
-std::string jit_hash(const std::string &text);
+// A 128-bit content hash (the first half of the SHA-256), as 32 hex digits.
+std::string jit_hash(std::string_view text);
+
+// The SHA-256 of text (FIPS 180-4), as 64 hex digits.
+std::string jit_sha256(std::string_view text);
 
 } // namespace sicm
