@@ -40,6 +40,13 @@ std::string emit_c_assignments(const std::vector<ExprId> &values,
 // bytes; "anonymous" if s is empty.
 std::string c_sanitize(std::string_view s, size_t max_len = 48);
 
+// The C name of the kernel for the procedure named `name`: "sicm_kernel_"
+// and the name itself if it is at most 40 bytes of [A-Za-z0-9_] (and does not
+// end like the other form), else the name sanitized and cut to 40 bytes, "_h"
+// and 16 hex digits of its SHA-256. Distinct names give distinct C names (up
+// to a 64-bit hash collision), never longer than 70 bytes.
+std::string c_kernel_name(std::string_view name);
+
 // A finite or infinite double as a C expression that denotes exactly it:
 // "0.5", "1.0", "-2.5e-10", "INFINITY", "NAN".
 std::string c_double_literal(double d);

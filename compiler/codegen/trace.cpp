@@ -243,7 +243,7 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   std::string kname = name ? name : procedure_name(proc);
   Trace t;
   if (!trace_procedure(proc, sample_args, &t, why_not)) return nullptr;
-  std::string c_name = "sicm_kernel_" + c_sanitize(kname);
+  std::string c_name = c_kernel_name(kname);
   std::string source = emit_kernel_unit(t, c_name, kname);
   std::string so;
   void *fn = jit_load(source, c_name, &so, why_not);
