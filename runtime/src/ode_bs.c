@@ -1,8 +1,9 @@
 /* Bulirsch-Stoer: modified midpoint rule with extrapolation, adaptive in order and step size.
  *
  * Approach. One step of length H from (t, y) is computed several times with
- * Gragg's modified midpoint rule, using n_j = 2j substeps of size H/n_j for
- * j = 1, 2, ... (the "harmonic" or Deuflhard sequence). Gragg showed that
+ * Gragg's modified midpoint rule, using n_j substeps of size H/n_j for
+ * j = 1, 2, ..., with n_j = 2, 4, 6, 8, 12, 16, 24, 32 (Bulirsch's
+ * sequence, that of the original method and of scmutils). Gragg showed that
  * the error of that rule has an asymptotic expansion in even powers of the
  * substep size, so the results T_j1 can be extrapolated to substep size
  * zero by fitting a polynomial in (H/n_j)^2 and evaluating it at 0. The
@@ -14,6 +15,23 @@
  * of the two best entries of a row, T_{jj} - T_{j,j-1}, estimates the error
  * of the lower one and is what the error test uses, so the step keeps the
  * more accurate T_{jj} (local extrapolation).
+ *
+ * Smoothness. Results should depend smoothly on the initial state: the
+ * book differentiates surface-of-section maps by central differences with
+ * increments of 1e-6 at tolerance 1e-12 (Figure 3.12, area preservation),
+ * which needs the map to vary by much less than 1e-12 except through the
+ * state. Two things break that, and both are dealt with here:
+ *
+ *   - Rounding in the extrapolation. T_jj = sum_i c_i T_i1, and for the
+ *     harmonic sequence n_j = 2j of ODEX the absolute sum of the weights
+ *     (the Lebesgue constant) is 56, 119 and 256 at rows 7 to 9: the few
+ *     units in the last place of rounding error in each midpoint result
+ *     become 100 to 500 units in T_jj, a noise of about 3e-13 at |y| = 10
+ *     that differs from one initial state to the next. With Bulirsch's
+ *     sequence the constant stays below 9 up to row 8. Its rows need more
+ *     substeps: the work grows by 5 to 35% at tolerances 1e-8 to 1e-12, and
+ *     by up to 50% at 1e-14.
+ *   - Step sizes chosen from noise. See the last point of Control.
  *
  * Control. We follow the order and step size strategy of Deuflhard (1983)
  * as presented by Hairer, Norsett and Wanner, "Solving Ordinary Differential
@@ -36,6 +54,14 @@
  *     W_{a-1} < 0.8 W_a, raise it if W_a < 0.9 W_{a-1} (row a+1 was not
  *     computed, so its step is estimated as H_a A_{a+1} / A_a); otherwise
  *     keep it. Right after a rejection neither order nor step may grow.
+ *   - An estimate err_j below the rounding level of T_jj (see noise_floor)
+ *     measures rounding, not truncation, and is raised to that level before
+ *     it predicts H_j. Otherwise the first step, which the initial step
+ *     guess keeps short, has an estimate that is rounding noise (0 from one
+ *     initial state, 4e-5 from another 1e-6 away); the growth factors it
+ *     gives, and after them the whole sequence of steps and orders, change
+ *     at random from one initial state to the next, and the result jumps by
+ *     about the tolerance.
  *
  * Between calls the step size and target row persist. A step shortened to
  * land exactly on the caller's t1 is accepted at the first row that meets
@@ -49,9 +75,14 @@
  * would not move t (H below the resolution of t) fails with SICM_ESTEP.
  *
  * Limits. Explicit method: on stiff problems the step is limited by
- * stability and the work explodes (use msbdf or cvode-bdf). Orders go up to
- * 2 (kMaxRow - 1) = 18 with kMaxRow = 10 rows; at tolerances near machine
+ * stability and the work explodes (use msbdf or cvode-bdf). Target orders
+ * go up to 2 (kMaxRow - 1) = 14 with kMaxRow = 8 rows (a step may end at
+ * row 8, order 16, costing 105 evaluations); at tolerances near machine
  * precision round-off in the extrapolation limits the attainable accuracy.
+ * Like every adaptive method, the result is only piecewise smooth in the
+ * initial state: where a small change of it changes the number of steps or
+ * an order, the result jumps by about the error, which is of the order of
+ * the tolerance.
  * Gragg's smoothing step (the average at the end of the midpoint rule) is
  * used; it costs one evaluation per row and damps the midpoint rule's weakly
  * unstable oscillation. There is no dense output: steps are shortened to hit
@@ -64,7 +95,15 @@
 
 #include "ode_internal.h"
 
-enum { kMaxRow = 10 }; /* rows j = 1..kMaxRow with n_j = 2j; targets 2..kMaxRow-1 */
+enum { kMaxRow = 8 }; /* rows j = 1..kMaxRow; targets 2..kMaxRow-1 */
+
+/* Substeps n_j of row j (index 0 unused): Bulirsch's sequence, n_j = 2 n_{j-2}. */
+static const int kSubsteps[kMaxRow + 1] = {0, 2, 4, 6, 8, 12, 16, 24, 32};
+
+/* Rounding error of one midpoint result T_j1, in units of the last place
+ * of the solution, before the extrapolation amplifies it (see noise_floor):
+ * the n_j <= 32 substeps add up to about sqrt(n_j) units. */
+static const double kMidpointUlps = 8;
 
 typedef struct {
   int k;         /* target row for the next step, 2..kMaxRow-1 */
@@ -72,11 +111,27 @@ typedef struct {
   double *f0;    /* derivative at the start of the step */
   double *table; /* kMaxRow rows of dim: the Aitken-Neville tableau, see extrapolate */
   double *z0, *z1, *fz, *diff, *work;
-  double cost[kMaxRow + 1]; /* A_j: rhs evaluations to build rows 1..j */
+  double cost[kMaxRow + 1];     /* A_j: rhs evaluations to build rows 1..j */
+  double lebesgue[kMaxRow + 1]; /* sum of |weights| of T_i1 in T_jj */
 } bs_state;
 
 static int n_of(int j) {
-  return 2 * j;
+  return kSubsteps[j];
+}
+
+/* The Lebesgue constant of extrapolation at row j: T_jj = sum_i c_i T_i1
+ * with c_i the Lagrange weights at 0 of the nodes (1/n_i)^2, and this is
+ * sum_i |c_i|, the factor by which rounding errors in the T_i1 can grow. */
+static double lebesgue_constant(int j) {
+  double sum = 0;
+  for (int i = 1; i <= j; i++) {
+    double c = 1;
+    const double ni2 = (double)n_of(i) * n_of(i);
+    for (int l = 1; l <= j; l++)
+      if (l != i) c *= ni2 / (ni2 - (double)n_of(l) * n_of(l));
+    sum += fabs(c);
+  }
+  return sum;
 }
 
 static double *row(const sicm_ode *o, bs_state *b, int j) {
@@ -103,8 +158,10 @@ static int bs_init(sicm_ode *o) {
   b->diff = b->fz + n;
   b->work = b->diff + n; /* 2n */
   b->cost[0] = 1;        /* f0 */
-  for (int j = 1; j <= kMaxRow; j++)
+  for (int j = 1; j <= kMaxRow; j++) {
     b->cost[j] = b->cost[j - 1] + n_of(j);
+    b->lebesgue[j] = lebesgue_constant(j);
+  }
   b->k = initial_target(o);
   return SICM_SUCCESS;
 }
@@ -162,6 +219,24 @@ static void extrapolate(const sicm_ode *o, bs_state *b, int j) {
     for (size_t i = 0; i < dim; i++)
       lo[i] = hi[i] + (hi[i] - lo[i]) * c;
   }
+}
+
+/* The level below which the error estimate of row j is rounding noise, in
+ * the units of sicm_ode_error_norm: kMidpointUlps units in the last place
+ * of each component (the larger of its start and end values), times the
+ * row's Lebesgue constant. It is capped at 0.1, well below the error the
+ * step size prediction aims at, so that at tolerances near the rounding
+ * level it slows the growth of the step but never shrinks it. */
+static double noise_floor(const sicm_ode *o, const bs_state *b, int j, const double *y0,
+                          const double *y1) {
+  const double ulps = kMidpointUlps * b->lebesgue[j] * DBL_EPSILON;
+  double m = 0;
+  for (size_t i = 0; i < o->dim; i++) {
+    const double scale = o->abs_tol + o->rel_tol * fabs(y1[i]);
+    const double r = ulps * fmax(fabs(y0[i]), fabs(y1[i])) / scale;
+    if (r > m) m = r;
+  }
+  return fmin(m, 0.1);
 }
 
 static int fail_step_size(sicm_ode *o, double t, const double *y, double H) {
@@ -249,7 +324,8 @@ static int bs_evolve(sicm_ode *o, double *t, double t1, double *y) {
         break;
       }
       const double expo = 1.0 / (2 * j - 1);
-      const double fac = err == 0 ? 4.0 : fmin(4.0, fmax(0.02, 0.94 * pow(0.65 / err, expo)));
+      const double e = fmax(err, noise_floor(o, b, j, y, best));
+      const double fac = e == 0 ? 4.0 : fmin(4.0, fmax(0.02, 0.94 * pow(0.65 / e, expo)));
       Hopt[j] = H * fac;
       W[j] = b->cost[j] / fabs(Hopt[j]);
       last = j;
