@@ -2,7 +2,8 @@
 #
 #   make            build build/sicm and build/libsicmrt.a
 #   make check      install missing Debian packages, build, run every test
-#   make demo       install missing Debian packages, build, run an example scene
+#   make demo       install missing Debian packages, build, compile an example
+#                   scene with sicm build and run it (writes its SVG)
 #   make examples   run every figure scene at full size into build/figures
 #   make install    install sicm under $(PREFIX)
 #   make clean
@@ -84,7 +85,8 @@ check: deps
 demo: deps
 	@$(MAKE) --no-print-directory all
 	@mkdir -p $(BUILD)/demo
-	$(SICM) run examples/demo.sicm --plot-dir $(BUILD)/demo
+	$(SICM) build examples/driven-pendulum.sicm -o $(BUILD)/demo/driven-pendulum
+	$(BUILD)/demo/driven-pendulum --plot-dir $(BUILD)/demo
 	@echo "plot: $(BUILD)/demo/driven-pendulum.svg (data: $(BUILD)/demo/driven-pendulum.tsv)"
 
 # Every figure scene at full size, into $(BUILD)/figures.

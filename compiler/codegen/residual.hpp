@@ -55,6 +55,8 @@ enum class RCompute : uint8_t {
   Truncate, // trunc(a[0])
   Max,      // fmax(a[0], a[1]) (NaN-propagating like MIT's max)
   Min,
+  RealTime, // milliseconds since the epoch, read when the statement runs
+  RunTime,  // processor seconds, read when the statement runs
 };
 
 enum class RKind : uint8_t {

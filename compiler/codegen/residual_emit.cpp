@@ -271,6 +271,8 @@ private:
       case RCompute::Max:
         e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmax(" + a[0] + ", " + a[1] + ")";
         break;
+      case RCompute::RealTime: e = "sicm_real_time()"; break;
+      case RCompute::RunTime: e = "sicm_run_time()"; break;
       case RCompute::Min:
         e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmin(" + a[0] + ", " + a[1] + ")";
         break;

@@ -347,6 +347,14 @@ template <const char *Name, RCompute C> Value P_fold(Value *a, int n) {
 constexpr char kMax[] = "max";
 constexpr char kMin[] = "min";
 
+// The clocks are read when the program runs, not when it is compiled.
+Value P_real_time(Value *, int) {
+  return let(RCompute::RealTime, {}, RType::Real);
+}
+Value P_runtime(Value *, int) {
+  return let(RCompute::RunTime, {}, RType::Real);
+}
+
 Value P_not(Value *a, int n) {
   if (is_dynamic_boolean(a[0])) return let(RCompute::Not, {expr_of(a[0], "not")}, RType::Boolean);
   return call_original("not", a, n);
@@ -877,16 +885,30 @@ bool hook_dynamic_test(Value test) {
   return is_dynamic_boolean(test);
 }
 
+// How a number, truth value or run-time value would be printed.
+RType scalar_type(Value v) {
+  if (v.is(Tag::Bool)) return RType::Boolean;
+  int id = var_of(v);
+  if (id >= 0) return g_prog->vars[id].type;
+  if (v.is(Tag::Fixnum) || v.is(Tag::Bignum)) return RType::Integer;
+  return RType::Real;
+}
+
 // The value that is `a` when test holds at run time and `b` otherwise.
 Value select_values(Value test, Value a, Value b) {
   if (eqv(a, b)) return a;
   bool a_scalar = is_number(a) || a.is(Tag::Bool) || is_dynamic_scalar(a);
   bool b_scalar = is_number(b) || b.is(Tag::Bool) || is_dynamic_scalar(b);
   if (a_scalar && b_scalar) {
-    bool boolean =
-        (a.is(Tag::Bool) || is_dynamic_boolean(a)) && (b.is(Tag::Bool) || is_dynamic_boolean(b));
-    return let(RCompute::Select, {expr_of(test, "if"), expr_of(a, "if"), expr_of(b, "if")},
-               boolean ? RType::Boolean : RType::Real);
+    // The printed form depends on the kind of number, which must not
+    // depend on the test: both truth values, both exact integers (or
+    // counts), or both inexact.
+    RType ta = scalar_type(a), tb = scalar_type(b);
+    if (ta != tb)
+      cannot_compile(here(), "the alternatives of a test on a value known only at run time give " +
+                                 describe(a) + " and " + describe(b) +
+                                 ", numbers of different kinds (exact and inexact)");
+    return let(RCompute::Select, {expr_of(test, "if"), expr_of(a, "if"), expr_of(b, "if")}, ta);
   }
   if (is_structure(a) && is_structure(b) && as_structure(a)->up == as_structure(b)->up &&
       as_structure(a)->len == as_structure(b)->len) {
@@ -983,6 +1005,8 @@ void begin_build_mode(ResidualProgram *program) {
   rebind("max", 1, kVariadic, P_fold<kMax, RCompute::Max>);
   rebind("min", 1, kVariadic, P_fold<kMin, RCompute::Min>);
   rebind("not", 1, 1, P_not);
+  rebind("real-time", 0, 0, P_real_time);
+  rebind("runtime", 0, 0, P_runtime);
   rebind("number?", 1, 1, P_number_test<kNumberP>);
   rebind("real?", 1, 1, P_number_test<kRealP>);
   rebind("inexact?", 1, 1, P_number_test<kInexactP>);

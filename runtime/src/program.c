@@ -7,12 +7,14 @@
  * of an integral's tolerance. Kernels are adapted to the runtime's callback
  * types by the small functions below; the runtime's error hook records the
  * last failure message so the driver can quote it. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime */
 #include <errno.h>
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "sicm/runtime.h"
 
@@ -81,6 +83,16 @@ void sicm_print_integer(double x) {
 
 void sicm_print_boolean(double x) {
   fputs(x != 0 ? "#t" : "#f", stdout);
+}
+
+double sicm_real_time(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+double sicm_run_time(void) {
+  return (double)clock() / CLOCKS_PER_SEC;
 }
 
 /* ---- plots ------------------------------------------------------------------------- */

@@ -67,6 +67,10 @@ void sicm_print_real(double x);
 void sicm_print_integer(double x);
 void sicm_print_boolean(double x);
 
+/* (real-time): milliseconds since the epoch; (runtime): processor seconds. */
+double sicm_real_time(void);
+double sicm_run_time(void);
+
 /* (frame xmin xmax ymin ymax [title]) and the marks added to it; a plot file
  * that cannot be created or written is a failure at `site`. NAME is the file
  * name without extension, TITLE may be NULL. */
