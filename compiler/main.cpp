@@ -13,6 +13,7 @@
 #include "codegen/kernel.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
+#include "eval/parameter.hpp"
 #include "eval/plot.hpp"
 #include "eval/procedure.hpp"
 #include "repl/repl.hpp"
@@ -30,9 +31,10 @@ constexpr size_t kEvalStackBytes = size_t(256) << 20;  // reserved; pages are to
 constexpr size_t kStackGuardMargin = size_t(16) << 20; // kept free for primitives
 
 const char kUsage[] =
-    "usage: sicm run FILE [--plot-dir DIR]\n"
+    "usage: sicm run FILE [--plot-dir DIR] [--param NAME=VALUE ...]\n"
     "                            evaluate a program, printing each top-level value;\n"
-    "                            plots (frame ...) are written to DIR (default .)\n"
+    "                            plots (frame ...) are written to DIR (default .);\n"
+    "                            --param sets (parameter 'NAME default)\n"
     "       sicm build FILE [-o EXE] [-O0|-O1|-O2|-O3] [--keep-c]\n"
     "                            compile to an executable (default: FILE without\n"
     "                            .sicm); --keep-c leaves the C as EXE.c\n"
@@ -152,8 +154,14 @@ int dispatch(const std::vector<std::string> &args) {
   if (cmd == "run") {
     std::string file;
     for (size_t i = 1; i < args.size(); ++i) {
+      std::string why;
       if (args[i] == "--plot-dir" && i + 1 < args.size()) {
         sicm::set_plot_directory(args[++i]);
+      } else if (args[i] == "--param" && i + 1 < args.size()) {
+        if (!sicm::set_parameter_option(args[++i], &why)) {
+          std::fprintf(stderr, "sicm: %s\n", why.c_str());
+          return kExitUsage;
+        }
       } else if (file.empty() && args[i].rfind("--", 0) != 0) {
         file = args[i];
       } else {

@@ -57,6 +57,7 @@ enum class RCompute : uint8_t {
   Min,
   RealTime, // milliseconds since the epoch, read when the statement runs
   RunTime,  // processor seconds, read when the statement runs
+  Param,    // the program's --param `text`, or a[0]
 };
 
 enum class RKind : uint8_t {
@@ -109,6 +110,7 @@ struct ResidualProgram {
   std::vector<RVar> vars;
   int plots = 0;
   std::string source_name; // the program's file name, for the executable's --help
+  std::vector<std::string> parameters; // names declared by (parameter 'name default)
 };
 
 } // namespace sicm

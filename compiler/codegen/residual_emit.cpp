@@ -81,8 +81,13 @@ public:
       out += "static void f" + std::to_string(f) +
              "(const double *in, double *out, const double *p);\n";
     out += "\n" + functions;
+    out += "static const char *const parameters[] = {";
+    for (const std::string &name : p_.parameters)
+      out += c_string_literal(name) + ", ";
+    out += "NULL};\n\n";
     out += "int main(int argc, char **argv) {\n";
-    out += "  sicm_program_init(argc, argv, " + c_string_literal(p_.source_name) + ");\n";
+    out += "  sicm_program_init(argc, argv, " + c_string_literal(p_.source_name) +
+           ", parameters);\n";
     out += main_body;
     out += "  sicm_plot_close_all();\n  return 0;\n}\n";
     return out;
@@ -272,6 +277,9 @@ private:
         e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmax(" + a[0] + ", " + a[1] + ")";
         break;
       case RCompute::RealTime: e = "sicm_real_time()"; break;
+      case RCompute::Param:
+        e = "sicm_program_param(" + c_string_literal(s.text) + ", " + a[0] + ")";
+        break;
       case RCompute::RunTime: e = "sicm_run_time()"; break;
       case RCompute::Min:
         e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmin(" + a[0] + ", " + a[1] + ")";

@@ -23,6 +23,7 @@
 //     list index) or that escapes the procedure it was computed in.
 #include "eval/build.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
@@ -353,6 +354,26 @@ Value P_real_time(Value *, int) {
 }
 Value P_runtime(Value *, int) {
   return let(RCompute::RunTime, {}, RType::Real);
+}
+
+// A parameter stays a run-time value: ./prog --param name=value sets it.
+Value P_parameter(Value *a, int) {
+  if (!is_symbol(a[0])) wrong_type(a[0], 1, "parameter");
+  if (!is_number(a[1])) wrong_type(a[1], 2, "parameter");
+  if (g_open.size() > 1)
+    cannot_compile(here(), "a parameter declared inside a procedure that runs at run time "
+                           "(declare it at top level)");
+  const std::string &name = symbol_name(a[0]);
+  std::vector<std::string> &names = g_prog->parameters;
+  if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  RStmt s{RKind::Let};
+  s.compute = RCompute::Param;
+  s.text = name;
+  s.args = {expr_from_number(a[1])};
+  Value v = new_var(RType::Real);
+  s.var = var_of(v);
+  emit(std::move(s));
+  return v;
 }
 
 Value P_not(Value *a, int n) {
@@ -1006,6 +1027,7 @@ void begin_build_mode(ResidualProgram *program) {
   rebind("min", 1, kVariadic, P_fold<kMin, RCompute::Min>);
   rebind("not", 1, 1, P_not);
   rebind("real-time", 0, 0, P_real_time);
+  rebind("parameter", 2, 2, P_parameter);
   rebind("runtime", 0, 0, P_runtime);
   rebind("number?", 1, 1, P_number_test<kNumberP>);
   rebind("real?", 1, 1, P_number_test<kRealP>);

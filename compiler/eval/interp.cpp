@@ -12,6 +12,7 @@
 #include "algebra/symbolic.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/analyze.hpp"
+#include "eval/parameter.hpp"
 #include "eval/builtins.hpp"
 #include "eval/core.hpp"
 #include "eval/number.hpp"
@@ -91,6 +92,7 @@ void init_interpreter() {
   install_series_primitives();
   install_numerics_primitives();
   install_kernel_primitives();
+  install_parameter_primitives();
   load_embedded_stdlib();
   set_first_user_file(register_source("<first user source>", "") + 1);
 }

@@ -35,21 +35,64 @@ static const char *reason_text(void) {
   return last_reason[0] ? last_reason : "failed";
 }
 
-void sicm_program_init(int argc, char **argv, const char *program_name) {
+enum { kMaxParams = 64 };
+static const char *param_names[kMaxParams];
+static double param_values[kMaxParams];
+static int nparams;
+
+static void usage(FILE *f, const char *argv0, const char *const *parameters) {
+  fprintf(f, "usage: %s [--plot-dir DIR]", argv0);
+  for (const char *const *p = parameters; *p; ++p)
+    fprintf(f, " [--param %s=VALUE]", *p);
+  fputc('\n', f);
+}
+
+/* Record --param NAME=VALUE; 0 if NAME is not declared or VALUE is not a number. */
+static int set_param(const char *assignment, const char *const *parameters) {
+  const char *eq = strchr(assignment, '=');
+  if (!eq || eq == assignment) return 0;
+  size_t len = (size_t)(eq - assignment);
+  for (const char *const *p = parameters; *p; ++p) {
+    if (strlen(*p) != len || strncmp(*p, assignment, len) != 0) continue;
+    char *end;
+    double x = strtod(eq + 1, &end);
+    if (eq[1] == '\0' || *end != '\0' || nparams == kMaxParams) return 0;
+    param_names[nparams] = *p;
+    param_values[nparams++] = x;
+    return 1;
+  }
+  return 0;
+}
+
+void sicm_program_init(int argc, char **argv, const char *program_name,
+                       const char *const *parameters) {
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--plot-dir") == 0 && i + 1 < argc) {
       plot_dir = argv[++i];
+    } else if (strcmp(argv[i], "--param") == 0 && i + 1 < argc) {
+      if (!set_param(argv[++i], parameters)) {
+        fprintf(stderr, "%s: --param %s: not NAME=NUMBER for a parameter of the program\n",
+                argv[0], argv[i]);
+        usage(stderr, argv[0], parameters);
+        exit(64);
+      }
     } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-      printf("usage: %s [--plot-dir DIR]\n"
-             "  a program compiled by sicm build from %s; plots go to DIR (default .)\n",
-             argv[0], program_name);
+      usage(stdout, argv[0], parameters);
+      printf("  a program compiled by sicm build from %s; plots go to DIR (default .)\n",
+             program_name);
       exit(0);
     } else {
-      fprintf(stderr, "usage: %s [--plot-dir DIR]\n", argv[0]);
+      usage(stderr, argv[0], parameters);
       exit(64);
     }
   }
   sicm_set_error_handler(record_reason);
+}
+
+double sicm_program_param(const char *name, double fallback) {
+  for (int i = nparams - 1; i >= 0; --i)
+    if (strcmp(param_names[i], name) == 0) return param_values[i];
+  return fallback;
 }
 
 void sicm_program_fail(const sicm_site *site, const char *who, const char *reason) {

@@ -45,10 +45,17 @@ typedef struct {
   int col;
 } sicm_site;
 
-/* sicm_program_init reads the executable's options (--plot-dir DIR, --help),
- * exiting with status 64 and a usage line for anything else, and arranges
- * for plots to be finished at exit and on SIGINT/SIGTERM. Call first. */
-void sicm_program_init(int argc, char **argv, const char *program_name);
+/* sicm_program_init reads the executable's options (--plot-dir DIR,
+ * --param NAME=VALUE for each NAME of the NULL-terminated `parameters`,
+ * --help), exiting with status 64 and a usage line for anything else, and
+ * arranges for plots to be finished at exit and on SIGINT/SIGTERM. Call
+ * first. */
+void sicm_program_init(int argc, char **argv, const char *program_name,
+                       const char *const *parameters);
+
+/* (parameter 'name default): the value given with --param NAME=VALUE, or
+ * the default. */
+double sicm_program_param(const char *name, double fallback);
 
 /* sicm_program_fail prints "WHERE: error: WHO: REASON", the source line and
  * a caret on stderr, finishes every plot and exits with status 70. */
