@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -74,8 +76,20 @@ void collect_kernel(const sicm::Kernel *k) {
 
 int emit_c(const std::string &path) {
   sicm::set_kernel_listener(collect_kernel);
-  char dir[] = "/tmp/sicm-emit-XXXXXX";
-  if (mkdtemp(dir)) sicm::set_plot_directory(dir);
+  // Plots go to a scratch directory, removed afterwards.
+  const char *tmp = std::getenv("TMPDIR");
+  std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/sicm-emit-XXXXXX";
+  std::vector<char> dir(pattern.begin(), pattern.end());
+  dir.push_back('\0');
+  bool have_dir = mkdtemp(dir.data()) != nullptr;
+  if (have_dir) sicm::set_plot_directory(dir.data());
+  struct RemoveDir {
+    const char *path;
+    ~RemoveDir() {
+      std::error_code ignored;
+      if (path) std::filesystem::remove_all(path, ignored);
+    }
+  } remove_dir{have_dir ? dir.data() : nullptr};
   std::fflush(stdout);
   int saved = dup(1);
   int null_fd = open("/dev/null", O_WRONLY);

@@ -58,6 +58,7 @@ enum class RCompute : uint8_t {
   RealTime, // milliseconds since the epoch, read when the statement runs
   RunTime,  // processor seconds, read when the statement runs
   Param,    // the program's --param `text`, or a[0]
+  ReadCell, // the current value of cell `cell`
 };
 
 enum class RKind : uint8_t {
@@ -68,6 +69,8 @@ enum class RKind : uint8_t {
   PlotPoint, // plot-point plot args[0] args[1]
   PlotLine,  // plot-line plot args[0..3]
   Close,     // graphics-close plot
+  SetCell,   // cell `cell` = args[0]
+  If,        // if (args[0] != 0) then_body else else_body
   Integral,  // outs[0] = integral of callee over [args[0], args[1]], tolerance number
   Minimize,  // outs[0..2] = Brent on callee over [args[0], args[1]], tolerance number
   Multimin,  // outs = Nelder-Mead of callee from args, tolerance number
@@ -88,11 +91,13 @@ struct RStmt {
   int plot = -1;                             // plot statements: the plot's number
   int callee = -1;                           // the function a numerical statement calls
   int monitor = -1;                          // Evolve: the monitor function, or -1
+  int cell = -1;                             // SetCell, Let of ReadCell
   double number = 0;                         // a tolerance
   bool time_first = false, rate_one = false; // Advance, Evolve
   std::string method;                        // Advance, Evolve: the runtime's step type variable
   std::string text, title;
-  SrcLoc loc; // the call, for run-time errors
+  SrcLoc loc;                              // the call, for run-time errors
+  std::vector<RStmt> then_body, else_body; // If
 };
 
 struct RFunction {
@@ -105,11 +110,19 @@ struct RFunction {
   SrcLoc loc;
 };
 
+// A global variable that a procedure run at run time assigns with set!: a C
+// global (cellN) that every function reads where the program reads it.
+struct RCell {
+  Symbol *global;
+  RType type;
+};
+
 struct ResidualProgram {
   std::vector<RFunction> functions; // [0] is main
   std::vector<RVar> vars;
+  std::vector<RCell> cells;
   int plots = 0;
-  std::string source_name; // the program's file name, for the executable's --help
+  std::string source_name;             // the program's file name, for the executable's --help
   std::vector<std::string> parameters; // names declared by (parameter 'name default)
 };
 

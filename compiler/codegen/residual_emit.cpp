@@ -75,6 +75,8 @@ public:
            "#include \"sicm/runtime.h\"\n\n";
     for (int i = 1; i <= p_.plots; ++i)
       out += "static sicm_plot *plot" + std::to_string(i) + ";\n";
+    for (size_t i = 0; i < p_.cells.size(); ++i)
+      out += "static double cell" + std::to_string(i) + ";\n";
     out += sites_;
     out += "\n";
     for (size_t f = 1; f < p_.functions.size(); ++f)
@@ -86,8 +88,8 @@ public:
       out += c_string_literal(name) + ", ";
     out += "NULL};\n\n";
     out += "int main(int argc, char **argv) {\n";
-    out += "  sicm_program_init(argc, argv, " + c_string_literal(p_.source_name) +
-           ", parameters);\n";
+    out +=
+        "  sicm_program_init(argc, argv, " + c_string_literal(p_.source_name) + ", parameters);\n";
     out += main_body;
     out += "  sicm_plot_close_all();\n  return 0;\n}\n";
     return out;
@@ -142,29 +144,64 @@ private:
   void analyze(int f) {
     const RFunction &fn = p_.functions[f];
     std::set<int> live;
+    std::set<int> &used = used_[f];
     for (ExprId o : fn.outputs)
       refs_of(o, nullptr, live);
-    std::vector<bool> keep(fn.body.size(), true);
-    for (size_t i = fn.body.size(); i-- > 0;) {
-      const RStmt &s = fn.body[i];
-      if (s.kind == RKind::Let && !live.count(s.var)) {
-        keep[i] = false;
-        continue;
-      }
-      if (s.kind == RKind::Print) live.insert(s.var);
-      for (ExprId a : s.args)
-        refs_of(a, &s, live);
-      for (int callee : {s.callee, s.monitor})
-        if (callee >= 0) live.insert(captures_[callee].begin(), captures_[callee].end());
-    }
-    keep_[f] = keep;
-    used_[f] = live;
-    for (int v : live) {
+    used.insert(live.begin(), live.end());
+    analyze_block(fn.body, live, used);
+    hoist(fn.body, false, hoisted_[f]);
+    for (int v : used) {
       const RVar &var = p_.vars[v];
       if (var.function == f) continue;
       if (!is_ancestor(var.function, f)) escape_error(var);
       captures_[f].insert(v);
     }
+  }
+
+  // Backward liveness over a block: a Let nobody needs afterwards is
+  // dropped; `live` is what is needed after the block on entry and before
+  // it on return; `used` collects every variable any kept statement needs.
+  void analyze_block(const std::vector<RStmt> &body, std::set<int> &live, std::set<int> &used) {
+    for (size_t i = body.size(); i-- > 0;) {
+      const RStmt &s = body[i];
+      if (s.kind == RKind::Let && !live.count(s.var)) {
+        dropped_.insert(&s);
+        continue;
+      }
+      std::set<int> needs;
+      if (s.kind == RKind::If) {
+        std::set<int> a = live, b = live;
+        analyze_block(s.then_body, a, used);
+        analyze_block(s.else_body, b, used);
+        live = a;
+        live.insert(b.begin(), b.end());
+      }
+      if (s.kind == RKind::Print) needs.insert(s.var);
+      for (ExprId a : s.args)
+        refs_of(a, &s, needs);
+      for (int callee : {s.callee, s.monitor})
+        if (callee >= 0) needs.insert(captures_[callee].begin(), captures_[callee].end());
+      live.insert(needs.begin(), needs.end());
+      used.insert(needs.begin(), needs.end());
+    }
+  }
+
+  // Variables defined inside an if: declared (as 0) where the function
+  // starts, so that the code after the if, which selects between the
+  // alternatives' values, can see them.
+  void hoist(const std::vector<RStmt> &body, bool in_branch, std::set<int> &out) {
+    for (const RStmt &s : body) {
+      if (in_branch) {
+        if (s.kind == RKind::Let) out.insert(s.var);
+        out.insert(s.outs.begin(), s.outs.end());
+      }
+      hoist(s.then_body, true, out);
+      hoist(s.else_body, true, out);
+    }
+  }
+
+  std::string decl(int f, int v) {
+    return hoisted_[f].count(v) ? var_name(v) : "const double " + var_name(v);
   }
 
   bool is_ancestor(int a, int f) {
@@ -240,8 +277,8 @@ private:
     return code;
   }
 
-  std::string statement(int f, size_t index, const RStmt &s) {
-    std::string prefix = "s" + std::to_string(index) + "_";
+  std::string statement(int f, const RStmt &s) {
+    std::string prefix = "s" + std::to_string(nstatements_++) + "_";
     std::string code;
     auto args = [&] { return operands(s.args, prefix, code); };
     switch (s.kind) {
@@ -255,7 +292,7 @@ private:
       break;
     }
     case RKind::Let: {
-      std::string v = "const double " + var_name(s.var);
+      std::string v = decl(f, s.var);
       if (s.compute == RCompute::Expr) {
         code += emit_c_assignments(
             s.args, {v}, [this](Symbol *x) { return spell(x); }, prefix + "t", "");
@@ -277,6 +314,7 @@ private:
         e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmax(" + a[0] + ", " + a[1] + ")";
         break;
       case RCompute::RealTime: e = "sicm_real_time()"; break;
+      case RCompute::ReadCell: e = "cell" + std::to_string(s.cell); break;
       case RCompute::Param:
         e = "sicm_program_param(" + c_string_literal(s.text) + ", " + a[0] + ")";
         break;
@@ -309,6 +347,11 @@ private:
       break;
     }
     case RKind::Close: code += "sicm_plot_finish(plot" + std::to_string(s.plot) + ");\n"; break;
+    case RKind::SetCell: {
+      std::vector<std::string> a = args();
+      code += "cell" + std::to_string(s.cell) + " = " + a[0] + ";\n";
+      break;
+    }
     case RKind::Integral:
     case RKind::FindRoot: {
       std::vector<std::string> a = args();
@@ -316,7 +359,7 @@ private:
       std::string call = std::string(fn) + "(" + site(s.loc) + ", " + closure(s.callee) + ", " +
                          a[0] + ", " + a[1] + ", " + c_double_literal(s.number) + ")";
       if (used_[f].count(s.outs[0]))
-        code += "const double " + var_name(s.outs[0]) + " = " + call + ";\n";
+        code += decl(f, s.outs[0]) + " = " + call + ";\n";
       else
         code += "(void)" + call + ";\n";
       break;
@@ -327,7 +370,7 @@ private:
                          a[0] + ", " + a[1] + ", " + a[2] + ", " +
                          std::to_string(static_cast<long>(s.number)) + ")";
       if (used_[f].count(s.outs[0]))
-        code += "const double " + var_name(s.outs[0]) + " = " + call + ";\n";
+        code += decl(f, s.outs[0]) + " = " + call + ";\n";
       else
         code += "(void)" + call + ";\n";
       break;
@@ -365,6 +408,7 @@ private:
       code += unpack(f, s.outs, y);
       break;
     }
+    case RKind::If: break; // written by block()
     case RKind::Fail: break;
     }
     return code;
@@ -377,25 +421,51 @@ private:
     return s;
   }
 
-  static std::string indent(const std::string &code) {
-    std::string out;
+  static std::string indent(const std::string &code, int depth) {
+    std::string out, pad(2 * depth, ' ');
     size_t start = 0;
     while (start < code.size()) {
       size_t end = code.find('\n', start);
+      if (end == std::string::npos) end = code.size();
       std::string line = code.substr(start, end - start);
       size_t first = line.find_first_not_of(' ');
-      out += "  " + (first == std::string::npos ? "" : line.substr(first)) + "\n";
+      out += pad + (first == std::string::npos ? "" : line.substr(first)) + "\n";
       start = end + 1;
     }
     return out;
   }
 
-  std::string body(int f) {
-    const RFunction &fn = p_.functions[f];
+  std::string block(int f, const std::vector<RStmt> &body, int depth) {
     std::string code;
-    for (size_t i = 0; i < fn.body.size(); ++i)
-      if (keep_[f][i]) code += statement(f, i, fn.body[i]);
-    return indent(code);
+    for (const RStmt &s : body) {
+      if (dropped_.count(&s)) continue;
+      if (s.kind != RKind::If) {
+        code += indent(statement(f, s), depth);
+        continue;
+      }
+      std::string then_code = block(f, s.then_body, depth + 1);
+      std::string else_code = block(f, s.else_body, depth + 1);
+      if (then_code.empty() && else_code.empty()) continue;
+      std::string test;
+      std::vector<std::string> t =
+          operands(s.args, "s" + std::to_string(nstatements_++) + "_", test);
+      code += indent(test, depth);
+      if (then_code.empty()) {
+        code += indent("if (" + t[0] + " == 0.0) {", depth) + else_code;
+      } else {
+        code += indent("if (" + t[0] + " != 0.0) {", depth) + then_code;
+        if (!else_code.empty()) code += indent("} else {", depth) + else_code;
+      }
+      code += indent("}", depth);
+    }
+    return code;
+  }
+
+  std::string body(int f) {
+    std::string code;
+    for (int v : hoisted_[f])
+      if (used_[f].count(v)) code += "  double " + var_name(v) + " = 0.0;\n";
+    return code + block(f, p_.functions[f].body, 1);
   }
 
   std::string function(int f) {
@@ -430,8 +500,9 @@ private:
 
   const ResidualProgram &p_;
   std::vector<std::set<int>> captures_;
-  std::map<int, std::vector<bool>> keep_;
-  std::map<int, std::set<int>> used_;
+  std::set<const RStmt *> dropped_;
+  std::map<int, std::set<int>> used_, hoisted_;
+  int nstatements_ = 0;
   std::map<Symbol *, int> var_ids_;
   std::string sites_;
   int nsites_ = 0;

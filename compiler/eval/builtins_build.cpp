@@ -75,6 +75,17 @@ RFunction &current() {
   return g_prog->functions[g_open.back()];
 }
 
+// Where statements go: the innermost open function's body, or the block of
+// an alternative under a run-time test being evaluated (owned by
+// hook_branch's frame). Function bodies are found by index: the function
+// vector grows while they are open.
+std::vector<std::vector<RStmt> *> g_blocks; // null: the open function's body
+
+std::vector<RStmt> &current_block() {
+  std::vector<RStmt> *b = g_blocks.empty() ? nullptr : g_blocks.back();
+  return b ? *b : current().body;
+}
+
 // ---- run-time values ----------------------------------------------------------------
 
 Value new_var(RType type) {
@@ -161,23 +172,121 @@ ExprId expr_of(Value v, const char *who) {
   cannot_compile(here(), std::string(who) + " needs a number here, not " + describe(v));
 }
 
-// ---- statements ---------------------------------------------------------------------
-
-bool is_effect(RKind k) {
-  return k != RKind::Let;
+// How a number, truth value or run-time value would be printed: an
+// expression of counts (exact integers combined by + and *) is a count.
+RType expr_type(ExprId id) {
+  const ExprNode &n = expr_node(id);
+  switch (n.kind) {
+  case ExprKind::Rational: return expr_is_exact_integer(id) ? RType::Integer : RType::Real;
+  case ExprKind::Flonum: return RType::Real;
+  case ExprKind::Symbol: {
+    auto it = g_var_of.find(n.sym);
+    return it == g_var_of.end() ? RType::Real : g_prog->vars[it->second].type;
+  }
+  case ExprKind::Apply:
+    if (n.op == Op::Add || n.op == Op::Mul) {
+      for (ExprId a : expr_arg_vector(id))
+        if (expr_type(a) != RType::Integer) return RType::Real;
+      return RType::Integer;
+    }
+    return RType::Real;
+  case ExprKind::Call: return RType::Real;
+  }
+  return RType::Real;
 }
 
+RType scalar_type(Value v) {
+  if (v.is(Tag::Bool)) return RType::Boolean;
+  int id = var_of(v);
+  if (id >= 0) return g_prog->vars[id].type;
+  if (v.is(Tag::Fixnum) || v.is(Tag::Bignum)) return RType::Integer;
+  if (v.is(Tag::Expr)) return expr_type(static_cast<ExprId>(v.i));
+  return RType::Real;
+}
+
+bool is_scalar(Value v) {
+  return is_number(v) || v.is(Tag::Bool) || is_dynamic_scalar(v);
+}
+
+// ---- statements ---------------------------------------------------------------------
+
+void read_cells();
+
 void emit(RStmt s) {
-  if (g_branch_depth > 0 && is_effect(s.kind))
-    cannot_compile(here(), "an effect (output, a plot, a numerical primitive) under a test on "
-                           "a value known only at run time");
   if (!s.loc.known()) s.loc = here();
-  std::vector<RStmt> &body = current().body;
+  std::vector<RStmt> &body = current_block();
   if (s.kind == RKind::Text && !body.empty() && body.back().kind == RKind::Text) {
     body.back().text += s.text;
     return;
   }
+  bool calls = s.callee >= 0 || s.monitor >= 0;
   body.push_back(std::move(s));
+  if (calls) read_cells(); // the call may have assigned them
+}
+
+// ---- cells: globals that procedures run at run time assign ----------------------------
+//
+// A set! of a global inside a traced procedure makes the global a cell (a C
+// global): the procedure is traced again from the start, now reading the
+// cell where it begins, and every function reads the cells again after each
+// call that may have assigned them. Only numbers and truth values can live
+// in a cell.
+
+struct Retrace {}; // thrown to trace the current numerical primitive again
+
+std::vector<bool> g_cell_initialized;
+
+int cell_of(Symbol *s) {
+  for (size_t i = 0; i < g_prog->cells.size(); ++i)
+    if (g_prog->cells[i].global == s) return static_cast<int>(i);
+  return -1;
+}
+
+void set_cell(int cell, Value v) {
+  RStmt s{RKind::SetCell};
+  s.cell = cell;
+  s.args = {expr_of(v, "set!")};
+  emit(std::move(s));
+}
+
+// Make every cell's global hold a fresh read of the cell in the current function.
+void read_cells() {
+  for (size_t i = 0; i < g_prog->cells.size(); ++i) {
+    if (!g_cell_initialized[i]) continue;
+    RStmt s{RKind::Let};
+    s.compute = RCompute::ReadCell;
+    s.cell = static_cast<int>(i);
+    Value v = new_var(g_prog->cells[i].type);
+    s.var = var_of(v);
+    current_block().push_back(std::move(s));
+    g_prog->cells[i].global->global = v;
+  }
+}
+
+// Run a numerical primitive, tracing it again whenever a traced procedure
+// turns a global into a cell (or widens a cell from counts to reals).
+Value with_retrace(const std::function<Value()> &body) {
+  size_t depth = g_open.size();
+  if (depth != 1) return body(); // the outermost primitive retraces
+  size_t nfunctions = g_prog->functions.size(), nvars = g_prog->vars.size();
+  for (;;) {
+    size_t nbody = current().body.size();
+    try {
+      return body();
+    } catch (const Retrace &) {
+      for (size_t v = nvars; v < g_prog->vars.size(); ++v)
+        g_var_of.erase(g_prog->vars[v].sym);
+      g_prog->functions.resize(nfunctions);
+      g_prog->vars.resize(nvars);
+      std::vector<RStmt> &main_body = current().body;
+      main_body.erase(main_body.begin() + static_cast<long>(nbody), main_body.end());
+      for (size_t i = 0; i < g_prog->cells.size(); ++i) {
+        if (g_cell_initialized[i]) continue;
+        g_cell_initialized[i] = true;
+        set_cell(static_cast<int>(i), g_prog->cells[i].global->global);
+      }
+    }
+  }
 }
 
 Value let(RCompute c, std::vector<ExprId> args, RType type) {
@@ -194,6 +303,14 @@ Value let(RCompute c, std::vector<ExprId> args, RType type) {
 Value as_var(Value v) {
   if (var_of(v) >= 0) return v;
   return let(RCompute::Expr, {expr_of(v, "printing")}, RType::Real);
+}
+
+template <PrimFn F> Value retrying(Value *a, int n) {
+  return with_retrace([&] { return F(a, n); });
+}
+
+template <NativeFn F> Value retrying_native(NativeProc *self, Value *a, int n) {
+  return with_retrace([&] { return F(self, a, n); });
 }
 
 // ---- output ---------------------------------------------------------------------------
@@ -474,17 +591,25 @@ public:
     f.loc = here();
     g_prog->functions.push_back(std::move(f));
     g_open.push_back(g_prog->functions.back().id);
+    g_blocks.push_back(nullptr);
     saved_depth_ = g_branch_depth;
     g_branch_depth = 0; // a test inside the traced procedure is its own
+    for (const RCell &c : g_prog->cells)
+      saved_.push_back(c.global->global);
+    read_cells();
   }
   ~FunctionScope() {
     g_open.pop_back();
+    g_blocks.pop_back();
     g_branch_depth = saved_depth_;
+    for (size_t i = 0; i < saved_.size() && i < g_prog->cells.size(); ++i)
+      g_prog->cells[i].global->global = saved_[i];
   }
   int id() const { return g_open.back(); }
 
 private:
   int saved_depth_;
+  gcvec<Value> saved_; // the cells' globals as the caller sees them
 };
 
 // A value shaped like `sample` (a number, or an up/down structure of them)
@@ -782,7 +907,8 @@ Value advance(NativeProc *self, Value *a, int n) {
 }
 
 Value P_state_advancer(Value *a, int n) {
-  return make_named(advance, sysder_of(a, n, "state-advancer"), &g_advancer_lambda);
+  return make_named(retrying_native<advance>, sysder_of(a, n, "state-advancer"),
+                    &g_advancer_lambda);
 }
 
 Value run_evolve(NativeProc *self, Value *a, int n) {
@@ -810,7 +936,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
 }
 
 Value P_evolve(Value *a, int n) {
-  return make_named(run_evolve, sysder_of(a, n, "evolve"), &g_evolver_lambda);
+  return make_named(retrying_native<run_evolve>, sysder_of(a, n, "evolve"), &g_evolver_lambda);
 }
 
 // ---- plots ------------------------------------------------------------------------------
@@ -906,15 +1032,6 @@ bool hook_dynamic_test(Value test) {
   return is_dynamic_boolean(test);
 }
 
-// How a number, truth value or run-time value would be printed.
-RType scalar_type(Value v) {
-  if (v.is(Tag::Bool)) return RType::Boolean;
-  int id = var_of(v);
-  if (id >= 0) return g_prog->vars[id].type;
-  if (v.is(Tag::Fixnum) || v.is(Tag::Bignum)) return RType::Integer;
-  return RType::Real;
-}
-
 // The value that is `a` when test holds at run time and `b` otherwise.
 Value select_values(Value test, Value a, Value b) {
   if (eqv(a, b)) return a;
@@ -946,6 +1063,15 @@ Value select_values(Value test, Value a, Value b) {
                              ", which cannot be chosen between at run time");
 }
 
+// Globals assigned while an alternative is evaluated: their values before
+// and after, so the other alternative starts from the same state and both
+// outcomes can be merged.
+struct Assignment {
+  Symbol *global;
+  Value before, after;
+};
+std::vector<std::vector<Assignment> *> g_undo;
+
 // Evaluate one alternative under a run-time test.
 Value speculate(const std::function<Value()> &alternative) {
   if (g_branch_depth >= kMaxBranchDepth || ++g_branch_evaluations > kMaxBranchEvaluations)
@@ -962,23 +1088,129 @@ Value speculate(const std::function<Value()> &alternative) {
   }
 }
 
-Value hook_branch(Value test, Node *then, Node *else_, Frame *env) {
-  Value a = speculate([&] { return eval(then, env); });
-  Value b = speculate([&] { return else_ ? eval(else_, env) : Value::unspecified(); });
+// Evaluate one alternative into its own block of statements, then undo
+// its assignments to globals (recorded in *log).
+Value alternative(std::vector<RStmt> &block, std::vector<Assignment> &log,
+                  const std::function<Value()> &eval_it) {
+  g_blocks.push_back(&block);
+  g_undo.push_back(&log);
+  auto restore = [&] {
+    g_blocks.pop_back();
+    g_undo.pop_back();
+    for (auto a = log.rbegin(); a != log.rend(); ++a) {
+      a->after = a->global->global;
+      a->global->global = a->before;
+    }
+  };
+  try {
+    Value v = speculate(eval_it);
+    restore();
+    return v;
+  } catch (...) {
+    restore();
+    throw;
+  }
+}
+
+bool block_calls(const std::vector<RStmt> &block) {
+  for (const RStmt &s : block)
+    if (s.callee >= 0 || s.monitor >= 0 || block_calls(s.then_body) || block_calls(s.else_body))
+      return true;
+  return false;
+}
+
+// Both alternatives of a test on a run-time truth value: their statements
+// become a C if/else, their values and the globals they assign are selected
+// between after it.
+Value branch(Value test, const std::function<Value()> &then_fn,
+             const std::function<Value()> &else_fn) {
+  std::vector<RStmt> then_block, else_block;
+  std::vector<Assignment> then_log, else_log;
+  Value a = alternative(then_block, then_log, then_fn);
+  Value b = alternative(else_block, else_log, else_fn);
+  bool calls = block_calls(then_block) || block_calls(else_block);
+  if (!g_undo.empty()) { // an enclosing alternative undoes what these did, too
+    for (const auto *log : {&then_log, &else_log})
+      for (const Assignment &x : *log)
+        g_undo.back()->push_back(Assignment{x.global, x.before, x.before});
+  }
+  if (!then_block.empty() || !else_block.empty()) {
+    RStmt s{RKind::If};
+    s.args = {expr_of(test, "if")};
+    s.then_body = std::move(then_block);
+    s.else_body = std::move(else_block);
+    current_block().push_back(std::move(s));
+  }
+  // A global either alternative assigned: the value it has after each.
+  std::vector<Symbol *> assigned;
+  for (const auto *log : {&then_log, &else_log})
+    for (const Assignment &x : *log)
+      if (std::find(assigned.begin(), assigned.end(), x.global) == assigned.end())
+        assigned.push_back(x.global);
+  for (Symbol *g : assigned) {
+    if (cell_of(g) >= 0) calls = true; // read it again after the if
+    Value after_then = g->global, after_else = g->global;
+    for (const Assignment &x : then_log)
+      if (x.global == g) after_then = x.after;
+    for (const Assignment &x : else_log)
+      if (x.global == g) after_else = x.after;
+    Value merged = cell_of(g) >= 0 ? g->global : select_values(test, after_then, after_else);
+    if (!g_undo.empty()) g_undo.back()->push_back(Assignment{g, g->global, merged});
+    g->global = merged;
+  }
+  if (calls) read_cells();
   return select_values(test, a, b);
 }
 
-Value hook_logic(Value test, Node *n, uint32_t from, bool is_and, Frame *env) {
-  Value rest = speculate([&] { return eval_logic_from(n, from, env); });
-  return is_and ? select_values(test, rest, Value::boolean(false))
-                : select_values(test, Value::boolean(true), rest);
+Value hook_branch(Value test, Node *then, Node *else_, Frame *env) {
+  return branch(
+      test, [&] { return eval(then, env); },
+      [&] { return else_ ? eval(else_, env) : Value::unspecified(); });
 }
 
-void hook_set_global(Symbol *s, SrcLoc loc) {
-  if (g_open.size() > 1)
-    cannot_compile(loc, "set! of the global variable " + s->name +
-                            " inside a procedure that runs at run time (it is traced once, "
-                            "at compile time)");
+Value hook_logic(Value test, Node *n, uint32_t from, bool is_and, Frame *env) {
+  auto rest = [&] { return eval_logic_from(n, from, env); };
+  if (is_and) return branch(test, rest, [] { return Value::boolean(false); });
+  return branch(
+      test, [] { return Value::boolean(true); }, rest);
+}
+
+Value hook_set_global(Symbol *s, Value v, SrcLoc loc) {
+  if (!g_undo.empty()) g_undo.back()->push_back(Assignment{s, s->global, v});
+  int cell = cell_of(s);
+  if (g_open.size() == 1) {
+    if (cell < 0) return v; // an ordinary assignment at compile time
+    if (!is_scalar(v))
+      cannot_compile(loc, "set! of " + s->name + " to " + describe(v) +
+                              ": a procedure run at run time assigns it, so it must hold a number");
+    if (scalar_type(v) == RType::Real) g_prog->cells[cell].type = RType::Real;
+    set_cell(cell, v);
+    return v;
+  }
+  if (!is_scalar(v) || !is_scalar(s->global))
+    cannot_compile(loc, "set! of the global variable " + s->name + " to " + describe(v) +
+                            " inside a procedure that runs at run time (a global it assigns "
+                            "can hold a number, not a list or a structure)");
+  if (cell < 0) {
+    if (g_open.size() > 2)
+      cannot_compile(loc, "set! of the global variable " + s->name +
+                              " inside a procedure run by another run-time procedure");
+    g_prog->cells.push_back(RCell{s, scalar_type(s->global)});
+    g_cell_initialized.push_back(false);
+    throw Retrace{};
+  }
+  RCell &c = g_prog->cells[cell];
+  RType t = scalar_type(v);
+  if (t != c.type) {
+    if (c.type == RType::Boolean || t == RType::Boolean)
+      cannot_compile(loc, "set! of " + s->name + " to a truth value and a number");
+    if (c.type == RType::Integer) {
+      c.type = RType::Real; // counts widen to reals: trace again with real reads
+      throw Retrace{};
+    }
+  }
+  set_cell(cell, v);
+  return v;
 }
 
 const DynamicBranchHooks kHooks = {hook_dynamic_test, hook_branch, hook_logic, hook_set_global};
@@ -996,6 +1228,7 @@ Value prepare_toplevel(Value v) {
 } // namespace
 
 void begin_build_mode(ResidualProgram *program) {
+  g_blocks = {nullptr};
   g_prog = program;
   RFunction main_fn;
   main_fn.id = 0;
@@ -1040,13 +1273,13 @@ void begin_build_mode(ResidualProgram *program) {
   rebind("exact->inexact", 1, 1, P_identity_on_dynamic<kExactToInexact>);
   rebind("inexact", 1, 1, P_identity_on_dynamic<kInexact>);
 
-  rebind("definite-integral", 3, 5, P_definite_integral);
-  rebind("minimize", 3, 4, P_minimize<kMinimize>);
-  rebind("brent-min", 3, 4, P_minimize<kBrentMin>);
-  rebind("multidimensional-minimize", 2, 3, P_multidimensional_minimize);
-  rebind("find-root", 3, 4, P_find_root);
+  rebind("definite-integral", 3, 5, retrying<P_definite_integral>);
+  rebind("minimize", 3, 4, retrying<P_minimize<kMinimize>>);
+  rebind("brent-min", 3, 4, retrying<P_minimize<kBrentMin>>);
+  rebind("multidimensional-minimize", 2, 3, retrying<P_multidimensional_minimize>);
+  rebind("find-root", 3, 4, retrying<P_find_root>);
   rebind("nelder-mead", 2, 5, P_not_yet);
-  rebind("bisect", 4, 5, P_bisect);
+  rebind("bisect", 4, 5, retrying<P_bisect>);
   rebind("state-advancer", 1, kVariadic, P_state_advancer);
   rebind("evolve", 1, kVariadic, P_evolve);
   rebind("frame", 4, 5, P_frame);

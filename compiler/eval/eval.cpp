@@ -305,7 +305,7 @@ Value eval(Node *n, Frame *env) {
       Value v = eval(n->kids[0], env);
       Symbol *s = n->value.symbol();
       if (!s->bound) runtime_error(n->loc, "Unbound variable: " + s->name);
-      if (g_dynamic_branch_hooks) g_dynamic_branch_hooks->set_global(s, n->loc);
+      if (g_dynamic_branch_hooks) v = g_dynamic_branch_hooks->set_global(s, v, n->loc);
       s->global = v;
       return Value::unspecified();
     }

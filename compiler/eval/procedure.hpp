@@ -101,8 +101,8 @@ struct DynamicBranchHooks {
   bool (*dynamic_test)(Value test);
   Value (*branch)(Value test, Node *then, Node *else_, Frame *env);
   Value (*logic)(Value test, Node *n, uint32_t from, bool is_and, Frame *env);
-  // set! of a global while a procedure is traced for run time.
-  void (*set_global)(Symbol *s, SrcLoc loc);
+  // set! of a global to v: returns the value to store.
+  Value (*set_global)(Symbol *s, Value v, SrcLoc loc);
 };
 extern const DynamicBranchHooks *g_dynamic_branch_hooks;
 

@@ -71,8 +71,8 @@ void sicm_program_init(int argc, char **argv, const char *program_name,
       plot_dir = argv[++i];
     } else if (strcmp(argv[i], "--param") == 0 && i + 1 < argc) {
       if (!set_param(argv[++i], parameters)) {
-        fprintf(stderr, "%s: --param %s: not NAME=NUMBER for a parameter of the program\n",
-                argv[0], argv[i]);
+        fprintf(stderr, "%s: --param %s: not NAME=NUMBER for a parameter of the program\n", argv[0],
+                argv[i]);
         usage(stderr, argv[0], parameters);
         exit(64);
       }
