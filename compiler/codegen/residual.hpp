@@ -71,6 +71,9 @@ enum class RKind : uint8_t {
   Close,     // graphics-close plot
   SetCell,   // cell `cell` = args[0]
   If,        // if (args[0] != 0) then_body else else_body
+  Loop,      // loop variables outs = args; repeat then_body (which ends in Break or Continue)
+  Continue,  // next iteration with loop variables outs = args
+  Break,     // leave the loop with results = args
   Integral,  // outs[0] = integral of callee over [args[0], args[1]], tolerance number
   Minimize,  // outs[0..2] = Brent on callee over [args[0], args[1]], tolerance number
   Multimin,  // outs = Nelder-Mead of callee from args, tolerance number
@@ -87,6 +90,7 @@ struct RStmt {
   RCompute compute = RCompute::Expr;
   std::vector<ExprId> args;
   std::vector<int> outs;                     // variable ids defined by the statement
+  std::vector<int> results;                  // Loop, Break: the loop's result variables
   int var = -1;                              // Let, Print
   int plot = -1;                             // plot statements: the plot's number
   int callee = -1;                           // the function a numerical statement calls

@@ -169,6 +169,16 @@ private:
         continue;
       }
       std::set<int> needs;
+      if (s.kind == RKind::Loop) {
+        // One iteration's statements end in Break or Continue, which use
+        // what they need: nothing of an iteration outlives it but the loop
+        // variables, which Continue assigns.
+        std::set<int> inner;
+        analyze_block(s.then_body, inner, used);
+        live.insert(inner.begin(), inner.end());
+        used.insert(s.outs.begin(), s.outs.end());
+        used.insert(s.results.begin(), s.results.end());
+      }
       if (s.kind == RKind::If) {
         std::set<int> a = live, b = live;
         analyze_block(s.then_body, a, used);
@@ -191,7 +201,11 @@ private:
   // alternatives' values, can see them.
   void hoist(const std::vector<RStmt> &body, bool in_branch, std::set<int> &out) {
     for (const RStmt &s : body) {
-      if (in_branch) {
+      if (s.kind == RKind::Loop) {
+        out.insert(s.outs.begin(), s.outs.end());
+        out.insert(s.results.begin(), s.results.end());
+      }
+      if (in_branch && s.kind != RKind::Continue) {
         if (s.kind == RKind::Let) out.insert(s.var);
         out.insert(s.outs.begin(), s.outs.end());
       }
@@ -408,7 +422,22 @@ private:
       code += unpack(f, s.outs, y);
       break;
     }
-    case RKind::If: break; // written by block()
+    case RKind::If:
+    case RKind::Loop: break; // written by block()
+    case RKind::Continue: {
+      std::vector<std::string> a = args(); // all new values first, then assign
+      for (size_t i = 0; i < s.outs.size(); ++i)
+        code += var_name(s.outs[i]) + " = " + a[i] + ";\n";
+      code += "continue;\n";
+      break;
+    }
+    case RKind::Break: {
+      std::vector<std::string> a = args();
+      for (size_t i = 0; i < s.results.size(); ++i)
+        code += var_name(s.results[i]) + " = " + a[i] + ";\n";
+      code += "break;\n";
+      break;
+    }
     case RKind::Fail: break;
     }
     return code;
@@ -439,6 +468,20 @@ private:
     std::string code;
     for (const RStmt &s : body) {
       if (dropped_.count(&s)) continue;
+      if (s.kind == RKind::Loop) {
+        std::string init;
+        std::vector<std::string> a =
+            operands(s.args, "s" + std::to_string(nstatements_++) + "_", init);
+        for (size_t i = 0; i < s.outs.size(); ++i)
+          init += var_name(s.outs[i]) + " = " + a[i] + ";\n";
+        code += indent(init, depth);
+        code += indent("for (;;) {", depth);
+        code += block(f, s.then_body, depth + 1);
+        code += indent("}", depth);
+        for (int v : s.outs) // a loop variable that only its own update reads
+          code += indent("(void)" + var_name(v) + ";", depth);
+        continue;
+      }
       if (s.kind != RKind::If) {
         code += indent(statement(f, s), depth);
         continue;

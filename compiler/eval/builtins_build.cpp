@@ -1033,8 +1033,12 @@ bool hook_dynamic_test(Value test) {
 }
 
 // The value that is `a` when test holds at run time and `b` otherwise.
+bool is_bottom(Value v);
+
 Value select_values(Value test, Value a, Value b) {
   if (eqv(a, b)) return a;
+  if (is_bottom(a)) return b; // that alternative goes on with the next iteration
+  if (is_bottom(b)) return a;
   bool a_scalar = is_number(a) || a.is(Tag::Bool) || is_dynamic_scalar(a);
   bool b_scalar = is_number(b) || b.is(Tag::Bool) || is_dynamic_scalar(b);
   if (a_scalar && b_scalar) {
@@ -1070,7 +1074,7 @@ struct Assignment {
   Symbol *global;
   Value before, after;
 };
-std::vector<std::vector<Assignment> *> g_undo;
+std::vector<gcvec<Assignment> *> g_undo; // logs hold Values: collected memory
 
 // Evaluate one alternative under a run-time test.
 Value speculate(const std::function<Value()> &alternative) {
@@ -1090,7 +1094,7 @@ Value speculate(const std::function<Value()> &alternative) {
 
 // Evaluate one alternative into its own block of statements, then undo
 // its assignments to globals (recorded in *log).
-Value alternative(std::vector<RStmt> &block, std::vector<Assignment> &log,
+Value alternative(std::vector<RStmt> &block, gcvec<Assignment> &log,
                   const std::function<Value()> &eval_it) {
   g_blocks.push_back(&block);
   g_undo.push_back(&log);
@@ -1125,7 +1129,7 @@ bool block_calls(const std::vector<RStmt> &block) {
 Value branch(Value test, const std::function<Value()> &then_fn,
              const std::function<Value()> &else_fn) {
   std::vector<RStmt> then_block, else_block;
-  std::vector<Assignment> then_log, else_log;
+  gcvec<Assignment> then_log, else_log;
   Value a = alternative(then_block, then_log, then_fn);
   Value b = alternative(else_block, else_log, else_fn);
   bool calls = block_calls(then_block) || block_calls(else_block);
@@ -1213,7 +1217,339 @@ Value hook_set_global(Symbol *s, Value v, SrcLoc loc) {
   return v;
 }
 
-const DynamicBranchHooks kHooks = {hook_dynamic_test, hook_branch, hook_logic, hook_set_global};
+// ---- loops: named procedures called again with run-time arguments ------------------------
+//
+// A call of a named procedure with a run-time number among its arguments is
+// evaluated as a loop candidate: its parameters that get run-time values
+// become loop variables, and a call of the same procedure (closure) while its
+// body is being evaluated records "continue with these values" and gives
+// Bottom, a value that never reaches a result: a test on a run-time value
+// whose alternative is Bottom selects the other one. If the body never calls
+// itself, its statements are spliced in place (it was an ordinary call);
+// else they become a C loop whose result is the value the body gives on the
+// paths that do not call it again. A parameter that gets a different known
+// number in the recursive call becomes a loop variable too (the body is
+// evaluated again); anything else (a list that shrinks, a result used by the
+// caller as in (* n (fact (- n 1))), a structure as argument) abandons the
+// loop, and the call is evaluated as it always is.
+
+struct LoopRetry {}; // evaluate the loop's body again with more loop variables
+struct LoopAbort {}; // not a loop: evaluate the call as usual
+
+void write_bottom(std::string &out, const void *, bool) {
+  out += "#[the value of a recursive call]";
+}
+
+const OpaqueKind kBottomKind = {"run-time-loop-continuation", write_bottom, nullptr};
+Value g_bottom;
+
+bool is_bottom(Value v) {
+  return v.is(Tag::Opaque) && v.as<Opaque>()->kind == &kBottomKind;
+}
+
+// The scalar leaves of a loop's result (a number or truth value, or a proper
+// list, structure or vector of them); false if it has others.
+bool result_leaves(Value v, gcvec<Value> &out) {
+  if (is_bottom(v)) return false;
+  if (is_scalar(v)) {
+    out.push_back(v);
+    return true;
+  }
+  if (is_pair(v) || is_null(v)) {
+    for (; is_pair(v); v = cdr(v))
+      if (!result_leaves(car(v), out)) return false;
+    return is_null(v);
+  }
+  size_t len;
+  Value *items = container_items(v, &len);
+  if (!items) return false;
+  for (size_t i = 0; i < len; ++i)
+    if (!result_leaves(items[i], out)) return false;
+  return true;
+}
+
+// A value shaped like `shape` (as result_leaves walks it) with new leaves.
+Value result_like(Value shape, const Value *&leaves) {
+  if (is_scalar(shape)) return *leaves++;
+  if (is_pair(shape) || is_null(shape)) {
+    gcvec<Value> items;
+    for (Value v = shape; is_pair(v); v = cdr(v))
+      items.push_back(result_like(car(v), leaves));
+    return list_from(items.data(), items.size());
+  }
+  size_t len;
+  Value *items = container_items(shape, &len);
+  SICM_ASSERT(items); // result_leaves accepted the shape
+  gcvec<Value> parts;
+  for (size_t i = 0; i < len; ++i)
+    parts.push_back(result_like(items[i], leaves));
+  if (is_structure(shape))
+    return make_structure_from(as_structure(shape)->up, parts.data(), parts.size());
+  Value v = make_vector(parts.size(), Value::fixnum(0));
+  for (size_t i = 0; i < parts.size(); ++i)
+    v.vector()->items[i] = parts[i];
+  return v;
+}
+
+// A parameter of a loop: known (the first call's argument, which every
+// call must repeat) or a loop variable: a number, a truth value, or a
+// list, structure or vector of them, one C variable per leaf.
+struct LoopParam {
+  bool variable = false;
+  Value shape;              // the first call's argument
+  std::vector<RType> types; // of the leaves
+  std::vector<int> vars;    // the leaves' variables in the current attempt
+};
+
+struct ActiveLoop {
+  Closure *closure;
+  bool watching = false;   // evaluated as an ordinary call until it calls itself
+  gcvec<LoopParam> params; // holds Values: collected memory
+  bool continued = false;
+};
+
+struct BecomeLoop { // a watched call called itself: evaluate it as a loop
+  Closure *closure;
+};
+std::vector<ActiveLoop *> g_loops; // loops whose bodies are being evaluated, innermost last
+
+// Do a and b have the same shape as loop values: both scalars, or lists,
+// structures or vectors of the same lengths with the same shapes inside?
+bool same_shape(Value a, Value b) {
+  if (is_scalar(a) || is_scalar(b)) return is_scalar(a) && is_scalar(b);
+  if (is_pair(a) || is_null(a) || is_pair(b) || is_null(b)) {
+    for (; is_pair(a) && is_pair(b); a = cdr(a), b = cdr(b))
+      if (!same_shape(car(a), car(b))) return false;
+    return is_null(a) && is_null(b);
+  }
+  size_t la = 0, lb = 0;
+  Value *x = container_items(a, &la), *y = container_items(b, &lb);
+  if (!x || !y || la != lb || a.tag != b.tag) return false;
+  if (is_structure(a) && as_structure(a)->up != as_structure(b)->up) return false;
+  for (size_t i = 0; i < la; ++i)
+    if (!same_shape(x[i], y[i])) return false;
+  return true;
+}
+
+// Make parameter p a loop variable shaped like v (a retry follows).
+void make_variable(LoopParam &p, Value v) {
+  gcvec<Value> leaves;
+  if (!result_leaves(v, leaves)) throw LoopAbort{};
+  p.variable = true;
+  p.types.clear();
+  for (Value leaf : leaves)
+    p.types.push_back(scalar_type(leaf));
+}
+
+Value record_continue(ActiveLoop &loop, Value *a, long n) {
+  RStmt s{RKind::Continue};
+  for (long i = 0; i < n; ++i) {
+    LoopParam &p = loop.params[i];
+    if (!p.variable) {
+      if (eqv(a[i], p.shape)) continue;
+      gcvec<Value> leaves;
+      if (!result_leaves(a[i], leaves) || !same_shape(a[i], p.shape))
+        throw LoopAbort{};    // a list that shrinks, ...
+      make_variable(p, a[i]); // known numbers that change: loop variables
+      throw LoopRetry{};
+    }
+    gcvec<Value> leaves;
+    if (!same_shape(a[i], p.shape) || !result_leaves(a[i], leaves)) throw LoopAbort{};
+    for (size_t k = 0; k < leaves.size(); ++k) {
+      RType t = scalar_type(leaves[k]);
+      if (t != p.types[k]) {
+        if (t == RType::Boolean || p.types[k] == RType::Boolean) throw LoopAbort{};
+        p.types[k] = RType::Real; // counts that become reals
+        throw LoopRetry{};
+      }
+      s.outs.push_back(p.vars[k]);
+      s.args.push_back(expr_of(leaves[k], "loop"));
+    }
+  }
+  emit(std::move(s));
+  loop.continued = true;
+  return g_bottom;
+}
+
+// Restores the builder's stacks and the program's size when a loop attempt
+// ends, by return or by exception.
+class LoopAttempt {
+public:
+  LoopAttempt(ActiveLoop *loop, std::vector<RStmt> *block)
+      : nfunctions_(g_prog->functions.size()), nvars_(g_prog->vars.size()), nloops_(g_loops.size()),
+        nblocks_(g_blocks.size()), nundo_(g_undo.size()) {
+    g_loops.push_back(loop);
+    g_blocks.push_back(block);
+    g_undo.push_back(&log_);
+  }
+  ~LoopAttempt() {
+    g_loops.resize(nloops_);
+    g_blocks.resize(nblocks_);
+    g_undo.resize(nundo_);
+  }
+  // Forget everything the attempt made.
+  void roll_back() {
+    for (auto a = log_.rbegin(); a != log_.rend(); ++a)
+      a->global->global = a->before;
+    for (size_t v = nvars_; v < g_prog->vars.size(); ++v)
+      g_var_of.erase(g_prog->vars[v].sym);
+    g_prog->functions.resize(nfunctions_);
+    g_prog->vars.resize(nvars_);
+  }
+  const gcvec<Assignment> &log() const { return log_; }
+
+private:
+  size_t nfunctions_, nvars_, nloops_, nblocks_, nundo_;
+  gcvec<Assignment> log_;
+};
+
+bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
+  Closure *c = f.as<Closure>();
+  for (auto l = g_loops.rbegin(); l != g_loops.rend(); ++l)
+    if ((*l)->closure == c) {
+      if ((*l)->watching) throw BecomeLoop{c};
+      *out = record_continue(**l, slots, n);
+      return true;
+    }
+  if (!c->lambda->name) return false;
+  bool any = false;
+  for (long i = 0; i < n; ++i)
+    any = any || contains_dynamic(slots[i]) || is_dynamic_boolean(slots[i]);
+  if (!any) return false;
+
+  // First as an ordinary call, watched: most calls never call themselves.
+  {
+    std::vector<RStmt> body;
+    Value v;
+    gcvec<Assignment> assigned;
+    bool recursive = false;
+    {
+      ActiveLoop watch;
+      watch.closure = c;
+      watch.watching = true;
+      LoopAttempt attempt(&watch, &body);
+      gcvec<Value> args(slots, slots + n);
+      try {
+        v = apply_procedure(f, args.data(), static_cast<int>(n));
+        assigned = attempt.log();
+      } catch (const BecomeLoop &b) {
+        attempt.roll_back();
+        if (b.closure != c) throw;
+        recursive = true;
+      }
+    }
+    if (!recursive) {
+      if (!g_undo.empty()) // an enclosing alternative undoes these assignments too
+        for (const Assignment &a : assigned)
+          g_undo.back()->push_back(a);
+      for (RStmt &x : body)
+        current_block().push_back(std::move(x));
+      *out = v;
+      return true;
+    }
+  }
+
+  ActiveLoop loop;
+  loop.closure = c;
+  for (long i = 0; i < n; ++i) {
+    LoopParam p;
+    p.shape = slots[i];
+    if (contains_dynamic(slots[i]) || is_dynamic_boolean(slots[i])) {
+      gcvec<Value> leaves;
+      if (!result_leaves(slots[i], leaves)) return false; // a procedure, ...: not a loop
+      make_variable(p, slots[i]);
+    }
+    loop.params.push_back(std::move(p));
+  }
+  for (;;) {
+    std::vector<RStmt> body;
+    Value v;
+    bool retry = false;
+    gcvec<Assignment> assigned;
+    {
+      LoopAttempt attempt(&loop, &body);
+      loop.continued = false;
+      gcvec<Value> args(slots, slots + n);
+      for (long i = 0; i < n; ++i) {
+        LoopParam &p = loop.params[i];
+        if (!p.variable) continue;
+        gcvec<Value> leaves;
+        p.vars.clear();
+        for (RType t : p.types) {
+          leaves.push_back(new_var(t));
+          p.vars.push_back(var_of(leaves.back()));
+        }
+        const Value *lp = leaves.data();
+        args[i] = result_like(p.shape, lp);
+      }
+      try {
+        v = apply_procedure(f, args.data(), static_cast<int>(n));
+        gcvec<Value> leaves;
+        if (loop.continued && !result_leaves(v, leaves)) throw LoopAbort{};
+        for (const Assignment &a : attempt.log())
+          if (loop.continued && cell_of(a.global) < 0) throw LoopAbort{};
+        assigned = attempt.log();
+      } catch (const LoopRetry &) {
+        attempt.roll_back();
+        retry = true;
+      } catch (const LoopAbort &) {
+        attempt.roll_back();
+        return false;
+      } catch (const Error &) {
+        attempt.roll_back();
+        return false; // evaluated again as usual: the error, if real, comes again
+      }
+    } // the stacks are the caller's again
+    if (retry) continue;
+    if (!g_undo.empty()) // an enclosing alternative undoes these assignments too
+      for (const Assignment &a : assigned)
+        g_undo.back()->push_back(a);
+    bool calls = block_calls(body);
+    RStmt s{loop.continued ? RKind::Loop : RKind::If};
+    for (const LoopParam &p : loop.params) {
+      if (!p.variable) continue;
+      gcvec<Value> inits;
+      result_leaves(p.shape, inits);
+      for (size_t k = 0; k < inits.size(); ++k) {
+        s.outs.push_back(p.vars[k]);
+        s.args.push_back(expr_of(inits[k], "loop"));
+      }
+    }
+    if (!loop.continued) {
+      // An ordinary call: its variables get their values, its statements
+      // follow in place.
+      for (size_t i = 0; i < s.outs.size(); ++i) {
+        RStmt l{RKind::Let};
+        l.var = s.outs[i];
+        l.args = {s.args[i]};
+        emit(std::move(l));
+      }
+      for (RStmt &x : body)
+        current_block().push_back(std::move(x));
+      *out = v;
+      return true;
+    }
+    gcvec<Value> leaves, results;
+    result_leaves(v, leaves);
+    RStmt brk{RKind::Break};
+    for (Value leaf : leaves) {
+      results.push_back(new_var(scalar_type(leaf)));
+      brk.results.push_back(var_of(results.back()));
+      brk.args.push_back(expr_of(leaf, "loop"));
+    }
+    s.results = brk.results;
+    body.push_back(std::move(brk));
+    s.then_body = std::move(body);
+    current_block().push_back(std::move(s));
+    if (calls) read_cells();
+    const Value *p = results.data();
+    *out = result_like(v, p);
+    return true;
+  }
+}
+
+const DynamicBranchHooks kHooks = {hook_dynamic_test, hook_branch, hook_logic, hook_set_global,
+                                   hook_call_closure};
 
 void rebind(const char *name, int min, int max, PrimFn fn) {
   Symbol *s = intern(name).symbol();
@@ -1229,6 +1565,7 @@ Value prepare_toplevel(Value v) {
 
 void begin_build_mode(ResidualProgram *program) {
   g_blocks = {nullptr};
+  g_bottom = Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kBottomKind, nullptr}));
   g_prog = program;
   RFunction main_fn;
   main_fn.id = 0;

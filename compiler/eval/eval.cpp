@@ -385,6 +385,10 @@ Value eval(Node *n, Frame *env) {
           Frame *fr = make_frame(c->env, lam->frame_size);
           for (long i = 0; i < nargs; ++i)
             fr->slots[i] = eval(n->kids[i + 1], env);
+          if (g_dynamic_branch_hooks) {
+            Value result;
+            if (g_dynamic_branch_hooks->call_closure(f, fr->slots, nargs, &result)) return result;
+          }
           env = fr;
         } else {
           env = bind_evaluated(f, c, n, env);

@@ -103,6 +103,10 @@ struct DynamicBranchHooks {
   Value (*logic)(Value test, Node *n, uint32_t from, bool is_and, Frame *env);
   // set! of a global to v: returns the value to store.
   Value (*set_global)(Symbol *s, Value v, SrcLoc loc);
+  // A call of closure f on evaluated arguments (a frame's slots, not to be
+  // kept): true and the result in *out if the hook evaluated the call itself
+  // (as a loop left for run time), false to let the evaluator go on.
+  bool (*call_closure)(Value f, Value *args, long nargs, Value *out);
 };
 extern const DynamicBranchHooks *g_dynamic_branch_hooks;
 
