@@ -117,7 +117,8 @@ struct RFunction {
 // A global variable that a procedure run at run time assigns with set!: a C
 // global (cellN) that every function reads where the program reads it.
 struct RCell {
-  Symbol *global;
+  Value *place;     // the global's value or the frame slot (frames are kept alive by the builder)
+  std::string name; // for messages
   RType type;
 };
 

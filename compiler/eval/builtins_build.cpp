@@ -159,6 +159,11 @@ bool contains_dynamic(Value v) {
 
 std::string describe(Value v) {
   std::string s = write_string(v);
+  for (size_t m; (m = s.find(kMarkerPrefix)) != std::string::npos;) {
+    size_t end = s.find(kMarkerSuffix, m + sizeof kMarkerPrefix - 1);
+    if (end == std::string::npos) break;
+    s.replace(m, end + sizeof kMarkerSuffix - 1 - m, "<run-time number>");
+  }
   if (s.size() > 60) s = s.substr(0, 60) + "...";
   return s;
 }
@@ -236,11 +241,14 @@ struct Retrace {}; // thrown to trace the current numerical primitive again
 
 std::vector<bool> g_cell_initialized;
 
-int cell_of(Symbol *s) {
+int cell_of(Value *place) {
   for (size_t i = 0; i < g_prog->cells.size(); ++i)
-    if (g_prog->cells[i].global == s) return static_cast<int>(i);
+    if (g_prog->cells[i].place == place) return static_cast<int>(i);
   return -1;
 }
+
+gcvec<Frame *> g_cell_frames; // keeps the frames of local cells alive (a scanned vector)
+std::vector<uint32_t> g_function_serials; // g_frame_serial when each open function began
 
 void set_cell(int cell, Value v) {
   RStmt s{RKind::SetCell};
@@ -259,7 +267,7 @@ void read_cells() {
     Value v = new_var(g_prog->cells[i].type);
     s.var = var_of(v);
     current_block().push_back(std::move(s));
-    g_prog->cells[i].global->global = v;
+    *g_prog->cells[i].place = v;
   }
 }
 
@@ -283,7 +291,7 @@ Value with_retrace(const std::function<Value()> &body) {
       for (size_t i = 0; i < g_prog->cells.size(); ++i) {
         if (g_cell_initialized[i]) continue;
         g_cell_initialized[i] = true;
-        set_cell(static_cast<int>(i), g_prog->cells[i].global->global);
+        set_cell(static_cast<int>(i), *g_prog->cells[i].place);
       }
     }
   }
@@ -525,6 +533,8 @@ template <const char *Name> Value P_identity_on_dynamic(Value *a, int n) {
 constexpr char kExactToInexact[] = "exact->inexact";
 constexpr char kInexact[] = "inexact";
 
+bool container_items_of(Value v);
+
 // ---- states: numbers in nested up/down structures and vectors ----------------------------
 
 // The components of a container (structure or vector), or null.
@@ -538,6 +548,11 @@ Value *container_items(Value v, size_t *len) {
     return v.vector()->items;
   }
   return nullptr;
+}
+
+bool container_items_of(Value v) {
+  size_t len;
+  return container_items(v, &len) != nullptr;
 }
 
 void state_leaves(Value v, gcvec<Value> &out) {
@@ -592,18 +607,20 @@ public:
     g_prog->functions.push_back(std::move(f));
     g_open.push_back(g_prog->functions.back().id);
     g_blocks.push_back(nullptr);
+    g_function_serials.push_back(g_frame_serial);
     saved_depth_ = g_branch_depth;
     g_branch_depth = 0; // a test inside the traced procedure is its own
     for (const RCell &c : g_prog->cells)
-      saved_.push_back(c.global->global);
+      saved_.push_back(*c.place);
     read_cells();
   }
   ~FunctionScope() {
     g_open.pop_back();
     g_blocks.pop_back();
+    g_function_serials.pop_back();
     g_branch_depth = saved_depth_;
     for (size_t i = 0; i < saved_.size() && i < g_prog->cells.size(); ++i)
-      g_prog->cells[i].global->global = saved_[i];
+      *g_prog->cells[i].place = saved_[i];
   }
   int id() const { return g_open.back(); }
 
@@ -1071,7 +1088,7 @@ Value select_values(Value test, Value a, Value b) {
 // and after, so the other alternative starts from the same state and both
 // outcomes can be merged.
 struct Assignment {
-  Symbol *global;
+  Value *place; // a global's value or a frame slot
   Value before, after;
 };
 std::vector<gcvec<Assignment> *> g_undo; // logs hold Values: collected memory
@@ -1102,8 +1119,8 @@ Value alternative(std::vector<RStmt> &block, gcvec<Assignment> &log,
     g_blocks.pop_back();
     g_undo.pop_back();
     for (auto a = log.rbegin(); a != log.rend(); ++a) {
-      a->after = a->global->global;
-      a->global->global = a->before;
+      a->after = *a->place;
+      *a->place = a->before;
     }
   };
   try {
@@ -1136,7 +1153,7 @@ Value branch(Value test, const std::function<Value()> &then_fn,
   if (!g_undo.empty()) { // an enclosing alternative undoes what these did, too
     for (const auto *log : {&then_log, &else_log})
       for (const Assignment &x : *log)
-        g_undo.back()->push_back(Assignment{x.global, x.before, x.before});
+        g_undo.back()->push_back(Assignment{x.place, x.before, x.before});
   }
   if (!then_block.empty() || !else_block.empty()) {
     RStmt s{RKind::If};
@@ -1146,21 +1163,21 @@ Value branch(Value test, const std::function<Value()> &then_fn,
     current_block().push_back(std::move(s));
   }
   // A global either alternative assigned: the value it has after each.
-  std::vector<Symbol *> assigned;
+  std::vector<Value *> assigned;
   for (const auto *log : {&then_log, &else_log})
     for (const Assignment &x : *log)
-      if (std::find(assigned.begin(), assigned.end(), x.global) == assigned.end())
-        assigned.push_back(x.global);
-  for (Symbol *g : assigned) {
+      if (std::find(assigned.begin(), assigned.end(), x.place) == assigned.end())
+        assigned.push_back(x.place);
+  for (Value *g : assigned) {
     if (cell_of(g) >= 0) calls = true; // read it again after the if
-    Value after_then = g->global, after_else = g->global;
+    Value after_then = *g, after_else = *g;
     for (const Assignment &x : then_log)
-      if (x.global == g) after_then = x.after;
+      if (x.place == g) after_then = x.after;
     for (const Assignment &x : else_log)
-      if (x.global == g) after_else = x.after;
-    Value merged = cell_of(g) >= 0 ? g->global : select_values(test, after_then, after_else);
-    if (!g_undo.empty()) g_undo.back()->push_back(Assignment{g, g->global, merged});
-    g->global = merged;
+      if (x.place == g) after_else = x.after;
+    Value merged = cell_of(g) >= 0 ? *g : select_values(test, after_then, after_else);
+    if (!g_undo.empty()) g_undo.back()->push_back(Assignment{g, *g, merged});
+    *g = merged;
   }
   if (calls) read_cells();
   return select_values(test, a, b);
@@ -1179,35 +1196,42 @@ Value hook_logic(Value test, Node *n, uint32_t from, bool is_and, Frame *env) {
       test, [] { return Value::boolean(true); }, rest);
 }
 
-Value hook_set_global(Symbol *s, Value v, SrcLoc loc) {
-  if (!g_undo.empty()) g_undo.back()->push_back(Assignment{s, s->global, v});
-  int cell = cell_of(s);
-  if (g_open.size() == 1) {
+// An assignment of v to *place (a global's value or a local variable's
+// slot) named `name`. `outer`: the variable lives outside the procedure
+// being traced for run time, so its value must persist from one run-time
+// call to the next: a cell. `may_create`: it may become one here.
+Value assign(Value *place, const std::string &name, Value v, SrcLoc loc, bool outer,
+             bool may_create, Frame *frame) {
+  if (!g_undo.empty()) g_undo.back()->push_back(Assignment{place, *place, v});
+  int cell = cell_of(place);
+  if (!outer) {
     if (cell < 0) return v; // an ordinary assignment at compile time
     if (!is_scalar(v))
-      cannot_compile(loc, "set! of " + s->name + " to " + describe(v) +
+      cannot_compile(loc, "set! of " + name + " to " + describe(v) +
                               ": a procedure run at run time assigns it, so it must hold a number");
     if (scalar_type(v) == RType::Real) g_prog->cells[cell].type = RType::Real;
     set_cell(cell, v);
     return v;
   }
-  if (!is_scalar(v) || !is_scalar(s->global))
-    cannot_compile(loc, "set! of the global variable " + s->name + " to " + describe(v) +
-                            " inside a procedure that runs at run time (a global it assigns "
-                            "can hold a number, not a list or a structure)");
+  if (!is_scalar(v) || !is_scalar(*place))
+    cannot_compile(loc, "set! of " + name + " to " + describe(v) +
+                            " inside a procedure that runs at run time (a variable it keeps "
+                            "from one call to the next can hold a number, not " +
+                            describe(is_scalar(v) ? *place : v) + ")");
   if (cell < 0) {
-    if (g_open.size() > 2)
-      cannot_compile(loc, "set! of the global variable " + s->name +
-                              " inside a procedure run by another run-time procedure");
-    g_prog->cells.push_back(RCell{s, scalar_type(s->global)});
+    if (!may_create)
+      cannot_compile(loc,
+                     "set! of " + name + " inside a procedure run by another run-time procedure");
+    g_prog->cells.push_back(RCell{place, name, scalar_type(*place)});
     g_cell_initialized.push_back(false);
+    if (frame) g_cell_frames.push_back(frame);
     throw Retrace{};
   }
   RCell &c = g_prog->cells[cell];
   RType t = scalar_type(v);
   if (t != c.type) {
     if (c.type == RType::Boolean || t == RType::Boolean)
-      cannot_compile(loc, "set! of " + s->name + " to a truth value and a number");
+      cannot_compile(loc, "set! of " + name + " to a truth value and a number");
     if (c.type == RType::Integer) {
       c.type = RType::Real; // counts widen to reals: trace again with real reads
       throw Retrace{};
@@ -1215,6 +1239,19 @@ Value hook_set_global(Symbol *s, Value v, SrcLoc loc) {
   }
   set_cell(cell, v);
   return v;
+}
+
+Value hook_set_global(Symbol *s, Value v, SrcLoc loc) {
+  return assign(&s->global, "the global variable " + s->name, v, loc, g_open.size() > 1,
+                g_open.size() == 2, nullptr);
+}
+
+Value hook_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc) {
+  // Frames made before the innermost traced procedure began belong to its
+  // callers: state kept across run-time calls.
+  bool outer = g_open.size() > 1 && f->serial <= g_function_serials.back();
+  bool may_create = g_open.size() == 2;
+  return assign(&f->slots[index], "a local variable", v, loc, outer, may_create, f);
 }
 
 // ---- loops: named procedures called again with run-time arguments ------------------------
@@ -1255,6 +1292,7 @@ bool result_leaves(Value v, gcvec<Value> &out) {
     out.push_back(v);
     return true;
   }
+  if (!contains_dynamic(v) && !is_pair(v) && !container_items_of(v)) return true; // kept as is
   if (is_pair(v) || is_null(v)) {
     for (; is_pair(v); v = cdr(v))
       if (!result_leaves(car(v), out)) return false;
@@ -1271,6 +1309,7 @@ bool result_leaves(Value v, gcvec<Value> &out) {
 // A value shaped like `shape` (as result_leaves walks it) with new leaves.
 Value result_like(Value shape, const Value *&leaves) {
   if (is_scalar(shape)) return *leaves++;
+  if (!contains_dynamic(shape) && !is_pair(shape) && !container_items_of(shape)) return shape;
   if (is_pair(shape) || is_null(shape)) {
     gcvec<Value> items;
     for (Value v = shape; is_pair(v); v = cdr(v))
@@ -1317,6 +1356,7 @@ std::vector<ActiveLoop *> g_loops; // loops whose bodies are being evaluated, in
 // structures or vectors of the same lengths with the same shapes inside?
 bool same_shape(Value a, Value b) {
   if (is_scalar(a) || is_scalar(b)) return is_scalar(a) && is_scalar(b);
+  if (!is_pair(a) && !container_items_of(a) && !contains_dynamic(a)) return eqv(a, b);
   if (is_pair(a) || is_null(a) || is_pair(b) || is_null(b)) {
     for (; is_pair(a) && is_pair(b); a = cdr(a), b = cdr(b))
       if (!same_shape(car(a), car(b))) return false;
@@ -1390,7 +1430,7 @@ public:
   // Forget everything the attempt made.
   void roll_back() {
     for (auto a = log_.rbegin(); a != log_.rend(); ++a)
-      a->global->global = a->before;
+      *a->place = a->before;
     for (size_t v = nvars_; v < g_prog->vars.size(); ++v)
       g_var_of.erase(g_prog->vars[v].sym);
     g_prog->functions.resize(nfunctions_);
@@ -1487,7 +1527,7 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
         gcvec<Value> leaves;
         if (loop.continued && !result_leaves(v, leaves)) throw LoopAbort{};
         for (const Assignment &a : attempt.log())
-          if (loop.continued && cell_of(a.global) < 0) throw LoopAbort{};
+          if (loop.continued && cell_of(a.place) < 0) throw LoopAbort{};
         assigned = attempt.log();
       } catch (const LoopRetry &) {
         attempt.roll_back();
@@ -1548,8 +1588,8 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
   }
 }
 
-const DynamicBranchHooks kHooks = {hook_dynamic_test, hook_branch, hook_logic, hook_set_global,
-                                   hook_call_closure};
+const DynamicBranchHooks kHooks = {hook_dynamic_test, hook_branch,    hook_logic,
+                                   hook_set_global,   hook_set_local, hook_call_closure};
 
 void rebind(const char *name, int min, int max, PrimFn fn) {
   Symbol *s = intern(name).symbol();

@@ -147,6 +147,7 @@ Frame *make_frame(Frame *parent, uint32_t size) {
   if (!f) throw std::bad_alloc();
   f->parent = parent;
   f->size = size;
+  f->serial = ++g_frame_serial;
   for (uint32_t i = 0; i < size; ++i)
     f->slots[i].tag = Tag::Unassigned;
   return f;
@@ -273,6 +274,7 @@ struct TailApply {
 }
 
 const DynamicBranchHooks *g_dynamic_branch_hooks = nullptr;
+uint32_t g_frame_serial = 0;
 
 Value eval_logic_from(Node *n, uint32_t from, Frame *env) {
   bool is_and = n->kind == NodeKind::And;
@@ -298,6 +300,7 @@ Value eval(Node *n, Frame *env) {
       Frame *f = env;
       for (uint16_t d = n->depth; d > 0; --d)
         f = f->parent;
+      if (g_dynamic_branch_hooks) v = g_dynamic_branch_hooks->set_local(f, n->index, v, n->loc);
       f->slots[n->index] = v;
       return Value::unspecified();
     }

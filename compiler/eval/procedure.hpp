@@ -56,7 +56,8 @@ struct Lambda {
 struct Frame {
   Frame *parent;
   uint32_t size;
-  Value slots[1]; // really `size` slots
+  uint32_t serial; // order of creation (g_frame_serial when made; wraps, only compared in builds)
+  Value slots[1];  // really `size` slots
 };
 
 struct Closure {
@@ -103,12 +104,16 @@ struct DynamicBranchHooks {
   Value (*logic)(Value test, Node *n, uint32_t from, bool is_and, Frame *env);
   // set! of a global to v: returns the value to store.
   Value (*set_global)(Symbol *s, Value v, SrcLoc loc);
+  // set! of a local variable (slot `index` of frame f) to v: the value to store.
+  Value (*set_local)(Frame *f, uint32_t index, Value v, SrcLoc loc);
   // A call of closure f on evaluated arguments (a frame's slots, not to be
   // kept): true and the result in *out if the hook evaluated the call itself
   // (as a loop left for run time), false to let the evaluator go on.
   bool (*call_closure)(Value f, Value *args, long nargs, Value *out);
 };
 extern const DynamicBranchHooks *g_dynamic_branch_hooks;
+// Frames made so far (each frame records it as its serial).
+extern uint32_t g_frame_serial;
 
 // The and/or node n evaluated from argument `from` on (not a tail call).
 Value eval_logic_from(Node *n, uint32_t from, Frame *env);

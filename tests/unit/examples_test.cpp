@@ -1,4 +1,5 @@
-// The figure scenes of examples/ (examples/figure-*.sicm), run small.
+// The figure scenes of examples/ (examples/figure-*.sicm), run small, both
+// with `sicm run` and compiled by `sicm build`.
 //
 // Every scene begins with the line
 //     (define example-size 'full)
@@ -79,8 +80,8 @@ struct RunResult {
   std::string output; // stdout and stderr, for the failure message
 };
 
-// Run `sicm run program --plot-dir dir`, stdout and stderr to dir/output.txt.
-RunResult run_scene(const fs::path &program, const fs::path &dir) {
+// Run argv (argv[0] a path), stdout and stderr to dir/output.txt, within the timeout.
+RunResult run_command(const std::vector<std::string> &argv, const fs::path &dir) {
   RunResult r;
   fs::path out = dir / "output.txt";
   pid_t pid = fork();
@@ -92,8 +93,11 @@ RunResult run_scene(const fs::path &program, const fs::path &dir) {
       dup2(fd, 2);
       close(fd);
     }
-    execl(sicm_binary(), "sicm", "run", program.c_str(), "--plot-dir", dir.c_str(),
-          (char *)nullptr);
+    std::vector<char *> args;
+    for (const std::string &a : argv)
+      args.push_back(const_cast<char *>(a.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
     _exit(127);
   }
   if (pid < 0) return r;
@@ -115,6 +119,11 @@ RunResult run_scene(const fs::path &program, const fs::path &dir) {
   r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
   r.output = slurp(out);
   return r;
+}
+
+// `sicm run program --plot-dir dir`.
+RunResult run_scene(const fs::path &program, const fs::path &dir) {
+  return run_command({sicm_binary(), "run", program.string(), "--plot-dir", dir.string()}, dir);
 }
 
 std::string temp_dir() {
@@ -141,6 +150,21 @@ std::string trim_right(std::string s) {
   return s;
 }
 
+// DIR/NAME.svg is a whole SVG document and DIR/NAME.tsv has data.
+void expect_figure(const std::string &name, const std::string &dir) {
+  std::string svg = slurp(fs::path(dir) / (name + ".svg"));
+  EXPECT_FALSE(svg.empty()) << name << ".svg was not written (frame title must be \"" << name
+                            << "\")";
+  if (!svg.empty()) {
+    EXPECT_EQ(svg.rfind("<?xml", 0), 0u) << name << ".svg does not start with <?xml";
+    std::string end = trim_right(svg);
+    EXPECT_TRUE(end.size() >= 6 && end.compare(end.size() - 6, 6, "</svg>") == 0)
+        << name << ".svg does not end with </svg>";
+  }
+  std::string tsv = slurp(fs::path(dir) / (name + ".tsv"));
+  EXPECT_GE(data_lines(tsv), 1) << name << ".tsv has no data line";
+}
+
 class ExampleScene : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ExampleScene, RunsSmallAndDrawsItsFigure) {
@@ -161,20 +185,40 @@ TEST_P(ExampleScene, RunsSmallAndDrawsItsFigure) {
   RunResult r = run_scene(program, dir);
   EXPECT_FALSE(r.timed_out) << name << " ran longer than " << kTimeoutSeconds << " s";
   EXPECT_EQ(r.status, 0) << name << " (small) failed; its output:\n" << r.output;
-
-  std::string svg = slurp(fs::path(dir) / (name + ".svg"));
-  EXPECT_FALSE(svg.empty()) << name << ".svg was not written (frame title must be \"" << name
-                            << "\")";
-  if (!svg.empty()) {
-    EXPECT_EQ(svg.rfind("<?xml", 0), 0u) << name << ".svg does not start with <?xml";
-    std::string end = trim_right(svg);
-    EXPECT_TRUE(end.size() >= 6 && end.compare(end.size() - 6, 6, "</svg>") == 0)
-        << name << ".svg does not end with </svg>";
-  }
-  std::string tsv = slurp(fs::path(dir) / (name + ".tsv"));
-  EXPECT_GE(data_lines(tsv), 1) << name << ".tsv has no data line";
-
+  expect_figure(name, dir);
   if (!HasFailure()) fs::remove_all(dir);
+}
+
+// The same scene compiled by `sicm build` and run as an executable draws
+// the same number of points.
+TEST_P(ExampleScene, BuildsSmallAndDrawsItsFigure) {
+  struct stat st;
+  if (stat(sicm_binary(), &st) != 0) GTEST_SKIP() << "no sicm binary at " << sicm_binary();
+  const std::string name = GetParam();
+  std::string small = small_version(slurp(fs::path("examples") / (name + ".sicm")));
+  ASSERT_FALSE(small.empty());
+  std::string dir = temp_dir(), interpreted = temp_dir();
+  ASSERT_FALSE(dir.empty() || interpreted.empty()) << "cannot make a temporary directory";
+  const fs::path program = fs::path(dir) / (name + ".sicm");
+  std::ofstream(program, std::ios::binary) << small;
+  const fs::path exe = fs::path(dir) / name;
+
+  RunResult b = run_command({sicm_binary(), "build", program.string(), "-o", exe.string()}, dir);
+  ASSERT_EQ(b.status, 0) << name << " (small) does not build:\n" << b.output;
+  RunResult r = run_command({exe.string(), "--plot-dir", dir}, dir);
+  EXPECT_FALSE(r.timed_out) << name << " ran longer than " << kTimeoutSeconds << " s";
+  EXPECT_EQ(r.status, 0) << name << " (small, built) failed; its output:\n" << r.output;
+  expect_figure(name, dir);
+
+  RunResult i = run_scene(program, interpreted);
+  ASSERT_EQ(i.status, 0) << i.output;
+  EXPECT_EQ(data_lines(slurp(fs::path(dir) / (name + ".tsv"))),
+            data_lines(slurp(fs::path(interpreted) / (name + ".tsv"))))
+      << name << ": the built scene and sicm run plot different numbers of points";
+  if (!HasFailure()) {
+    fs::remove_all(dir);
+    fs::remove_all(interpreted);
+  }
 }
 
 std::string test_name(const ::testing::TestParamInfo<std::string> &info) {
