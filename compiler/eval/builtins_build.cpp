@@ -1095,9 +1095,14 @@ std::vector<gcvec<Assignment> *> g_undo; // logs hold Values: collected memory
 
 // Evaluate one alternative under a run-time test.
 Value speculate(const std::function<Value()> &alternative) {
-  if (g_branch_depth >= kMaxBranchDepth || ++g_branch_evaluations > kMaxBranchEvaluations)
+  if (g_branch_depth >= kMaxBranchDepth)
     cannot_compile(here(), "a loop or recursion whose end depends on a value known only at run "
                            "time");
+  if (++g_branch_evaluations > kMaxBranchEvaluations)
+    cannot_compile(here(), "more than " + std::to_string(kMaxBranchEvaluations) +
+                               " alternatives under tests on run-time values: the program "
+                               "unfolds too much (a loop whose arguments change shape, such as "
+                               "a list that grows, cannot become a C loop and is unfolded)");
   ++g_branch_depth;
   try {
     Value v = alternative();
