@@ -2,6 +2,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -15,6 +16,7 @@
 #include "codegen/kernel.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
+#include "eval/limits.hpp"
 #include "eval/parameter.hpp"
 #include "eval/plot.hpp"
 #include "eval/procedure.hpp"
@@ -45,10 +47,16 @@ const char kUsage[] =
     "                            run the program quietly and print the C of every\n"
     "                            kernel sicm run compiles (state derivatives, ...)\n"
     "       sicm repl            interactive read-eval-print loop\n"
-    "       sicm --version\n";
+    "       sicm --version\n"
+    "run, build, emit-c, emit-kernels and repl also take the limit flags\n"
+    "--max-steps, --max-memory, --max-expression-nodes, --max-recursion-depth and\n"
+    "--max-residual-size (sicm --help lists their defaults)\n";
 
 struct Job {
   std::vector<std::string> args;
+  sicm::Limits limits; // as given on the command line; 0 = the default
+  bool compile_time = false;
+  size_t stack_bytes = kEvalStackBytes;
   int status = 0;
 };
 
@@ -125,6 +133,7 @@ int dispatch(const std::vector<std::string> &args) {
   }
   if (cmd == "--help" || cmd == "-h") {
     std::fputs(kUsage, stdout);
+    std::fputs(("\n" + sicm::limits_usage()).c_str(), stdout);
     return 0;
   }
   if (cmd == "emit-kernels") {
@@ -196,9 +205,13 @@ int dispatch(const std::vector<std::string> &args) {
 void *evaluator_thread(void *arg) {
   Job *job = static_cast<Job *>(arg);
   char base;
-  sicm::set_stack_limit(&base, kEvalStackBytes - kStackGuardMargin);
+  sicm::set_stack_limit(&base, job->stack_bytes - kStackGuardMargin);
   try {
     sicm::init_interpreter();
+    // The library loaded, the user's limits apply.
+    sicm::set_stack_limit(&base, std::min(job->stack_bytes - kStackGuardMargin,
+                                          sicm::recursion_stack_bytes(job->limits)));
+    sicm::set_limits(job->limits, job->compile_time);
     job->status = dispatch(job->args);
   } catch (const sicm::Error &e) {
     sicm::flush_output();
@@ -225,12 +238,20 @@ int main(int argc, char **argv) {
   GC_INIT();
   Job job;
   job.args.assign(argv + 1, argv + argc);
+  std::string bad_limit;
+  if (!sicm::take_limit_flags(job.args, &job.limits, &bad_limit)) {
+    std::fprintf(stderr, "sicm: %s\n%s", bad_limit.c_str(), kUsage);
+    return kExitUsage;
+  }
+  job.compile_time = !job.args.empty() && (job.args[0] == "build" || job.args[0] == "emit-c");
+  job.stack_bytes = sicm::evaluator_stack_bytes(job.limits); // at least kEvalStackBytes
   pthread_attr_t attr;
   pthread_attr_init(&attr);
-  pthread_attr_setstacksize(&attr, kEvalStackBytes);
+  pthread_attr_setstacksize(&attr, job.stack_bytes);
   pthread_t thread;
   if (pthread_create(&thread, &attr, evaluator_thread, &job) != 0) {
-    std::fprintf(stderr, "sicm: cannot start the evaluator thread\n");
+    std::fprintf(stderr, "sicm: cannot start the evaluator thread (a stack of %zu MiB)\n",
+                 job.stack_bytes >> 20);
     return 1;
   }
   pthread_join(thread, nullptr);

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <vector>
 
+#include "eval/limits.hpp"
 #include "eval/number.hpp"
 
 namespace sicm {
@@ -73,6 +74,7 @@ template <class Same, class Make> ExprId intern_node(uint32_t hash, Same same, M
     i = (i + 1) & mask;
   }
   SICM_ASSERT(g_nodes.size() < kNoExpr);
+  check_expression_nodes(g_nodes.size()); // may throw; nothing is changed yet
   ExprId id = make();
   g_table[i] = id;
   return id;

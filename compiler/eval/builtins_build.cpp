@@ -35,6 +35,7 @@
 #include "algebra/symbolic.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
+#include "eval/limits.hpp"
 #include "eval/number.hpp"
 #include "eval/numerics_defaults.hpp"
 #include "eval/primitive.hpp"
@@ -224,6 +225,7 @@ void emit(RStmt s) {
     body.back().text += s.text;
     return;
   }
+  note_residual_statement(s.loc); // --max-residual-size
   bool calls = s.callee >= 0 || s.monitor >= 0;
   body.push_back(std::move(s));
   if (calls) read_cells(); // the call may have assigned them

@@ -6,11 +6,15 @@
 // stack. Only the evaluation of sub-expressions (operands, tests, non-final
 // body forms) recurses, and every recursion passes the stack guard, which
 // turns runaway recursion into MIT's "Aborting!: maximum recursion depth
-// exceeded" instead of a segfault.
+// exceeded" instead of a segfault; the recursion depth limit sets where the
+// guard stands.
+// Every iteration of the loop is one step for the step limit, whose counter
+// also notices Ctrl-C in the REPL (eval/limits.hpp).
 #include <string>
 
 #include "algebra/structure.hpp"
 #include "eval/core.hpp"
+#include "eval/limits.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
@@ -169,15 +173,18 @@ SrcLoc current_call_loc() {
   return g_call_loc;
 }
 
+void reset_call_loc(SrcLoc where) {
+  g_call_loc = where;
+}
+
 void set_stack_limit(char *stack_base, size_t usable_bytes) {
   g_stack_limit = stack_base - usable_bytes;
 }
 
 void check_stack(SrcLoc where) {
   char probe;
-  if (g_stack_limit && &probe < g_stack_limit)
-    runtime_error(where.known() ? where : g_call_loc,
-                  "Aborting!: maximum recursion depth exceeded");
+  if (g_stack_limit && &probe < g_stack_limit) [[unlikely]]
+    stack_exhausted(where.known() ? where : g_call_loc);
 }
 
 Value apply_procedure(Value proc, Value *args, int nargs) {
@@ -291,6 +298,7 @@ Value eval_logic_from(Node *n, uint32_t from, Frame *env) {
 Value eval(Node *n, Frame *env) {
   check_stack(n->loc);
   for (;;) {
+    count_step(n->loc);
     switch (n->kind) {
     case NodeKind::Const: return n->value;
     case NodeKind::LocalRef: return lookup_local(n, env);

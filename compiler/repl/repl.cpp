@@ -14,8 +14,10 @@
 // "finished" means the REPL can never disagree with it about strings,
 // character literals or comments.
 //
-// Errors never end the loop: a sicm::Error is reported in compiler style on
-// stderr, anything else as an internal error, and the next form is read.
+// Errors never end the loop: a sicm::Error (the limits of eval/limits.hpp
+// among them; each entry gets fresh step and expression budgets) is reported
+// in compiler style on stderr, anything else as an internal error, and the
+// next form is read.
 // Program output goes through output() so that the REPL knows the column and
 // can start its own lines on a fresh line.
 //
@@ -24,13 +26,14 @@
 // that the SIGINT and SIGWINCH handlers write to (the evaluator runs on a
 // thread of its own, so a signal may well be delivered to another thread;
 // the pipe wakes this one whichever thread gets it). Ctrl-C at a prompt
-// throws away the entry being typed; during evaluation the default SIGINT
-// action is back in place. Tab completes the names bound in the global
-// environment and the special-form keywords. History is loaded from the
-// history file at start and each line is appended to it as soon as it is
-// entered, so that a session killed by Ctrl-C keeps it; at exit the file is
-// trimmed. When stdin is not a terminal the loop reads plain lines with no
-// prompts, which makes it easy to drive from tests.
+// throws away the entry being typed; during evaluation (on a terminal or
+// not) it interrupts the evaluation, which ends with an "Interrupted" error,
+// and the loop goes on with the next form. Tab completes the names bound in
+// the global environment and the special-form keywords. History is loaded
+// from the history file at start and each line is appended to it as soon as
+// it is entered, so that a session killed by Ctrl-C keeps it; at exit the
+// file is trimmed. When stdin is not a terminal the loop reads plain lines
+// with no prompts, which makes it easy to drive from tests.
 #include "repl/repl.hpp"
 
 #include <fcntl.h>
@@ -55,6 +58,7 @@
 
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
+#include "eval/limits.hpp"
 #include "print/printer.hpp"
 #include "syntax/error.hpp"
 #include "syntax/reader.hpp"
@@ -98,8 +102,39 @@ void report_internal(const char *what) {
   std::fprintf(stderr, "sicm: internal error: %s\n", what);
 }
 
-// Evaluate one form and print its value. Nothing escapes.
+// Ctrl-C while a form is being evaluated: the evaluator raises
+// "Interrupted" at its next check and the loop carries on.
+void on_eval_interrupt(int) {
+  request_interrupt();
+}
+
+// Our SIGINT handler for as long as the object lives (the previous one
+// afterwards). Opening a plot installs the plot library's handler, which
+// finishes the plots and exits; it stays until the evaluation that opened
+// the plot ends.
+class EvalInterruptScope {
+public:
+  EvalInterruptScope() {
+    struct sigaction sa {};
+    sa.sa_handler = on_eval_interrupt;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    sigaction(SIGINT, &sa, &old_);
+  }
+  ~EvalInterruptScope() { sigaction(SIGINT, &old_, nullptr); }
+  EvalInterruptScope(const EvalInterruptScope &) = delete;
+  EvalInterruptScope &operator=(const EvalInterruptScope &) = delete;
+
+private:
+  struct sigaction old_ {};
+};
+
+// Evaluate one form and print its value. Nothing escapes: errors, the
+// limits of eval/limits.hpp and Ctrl-C all end in a message, and the next
+// form starts with fresh step and expression budgets.
 void eval_and_print(const ReadForm &form) {
+  begin_evaluation(form.loc);
+  EvalInterruptScope interrupts;
   try {
     print_result(form.datum, eval_toplevel(form.datum, form.loc));
   } catch (const Error &e) {

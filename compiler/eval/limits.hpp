@@ -1,0 +1,102 @@
+// Named limits on evaluation (steps, memory, expression nodes, recursion
+// depth, residual size) and interrupting it with Ctrl-C (see limits.cpp).
+//
+// Every limit is a command-line flag with a documented default. Hitting one
+// is an Error naming the limit and its flag, at the place evaluation had
+// reached, so `sicm run` exits 70, `sicm build` 65 and the REPL carries on.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "syntax/srcloc.hpp"
+
+namespace sicm {
+
+constexpr uint64_t kUnlimited = UINT64_MAX;
+
+// A value of 0 stands for "the default" until with_defaults fills it in.
+struct Limits {
+  uint64_t max_steps = 0;            // iterations of the evaluator's loop
+  uint64_t max_memory = 0;           // bytes of collected heap
+  uint64_t max_expression_nodes = 0; // new nodes in the expression arena
+  uint64_t max_recursion_depth = 0;  // levels of non-tail recursion
+  uint64_t max_residual_size = 0;    // statements of a built program
+};
+
+// The limits given, with the defaults of a command in place of the rest.
+// compile_time: build and emit-c, whose steps are limited by default too.
+Limits with_defaults(Limits given, bool compile_time);
+
+// Remove the limit flags (--max-steps=N or --max-steps N, and so on) from
+// args, storing their values in *given. False, with a message in *error, for
+// a malformed value or an unknown --max- flag.
+bool take_limit_flags(std::vector<std::string> &args, Limits *given, std::string *error);
+
+// The usage text's lines about the limit flags.
+std::string limits_usage();
+
+// The recursion depth limit is a limit on the evaluator's stack: N levels
+// may use N times the stack of one level of plain non-tail recursion. The
+// stack guard's allowance for a limit, and the evaluator thread's stack
+// reservation (the allowance and a margin for the primitives).
+size_t recursion_stack_bytes(const Limits &limits);
+size_t evaluator_stack_bytes(const Limits &limits);
+
+// Put limits (with defaults filled in) in force and start counting a new
+// evaluation from zero. Call on the evaluator thread after init_interpreter,
+// so the library's loading does not count. compile_time: errors are compile
+// errors (exit 65), else run-time errors (exit 70).
+void set_limits(const Limits &limits, bool compile_time);
+
+// A new top-level entry of the REPL, evaluating the form at `where`: steps
+// and expression nodes count from zero again, a pending interrupt is
+// forgotten.
+void begin_evaluation(SrcLoc where);
+
+// Ctrl-C: async-signal-safe; evaluation raises "Interrupted" at its next
+// check (within a few thousand steps or one new expression node) and at
+// every check after it until begin_evaluation.
+void request_interrupt();
+
+// sicm build: one more statement in the residual program, emitted at
+// `where`; raises the residual size error past the limit.
+void note_residual_statement(SrcLoc where);
+
+// Steps taken since the evaluation began (for tests and measurements).
+uint64_t steps_taken();
+
+// The location errors raised outside the evaluator loop report (eval.cpp).
+void reset_call_loc(SrcLoc where);
+
+// The stack guard tripped (check_stack): the recursion depth error.
+[[noreturn]] void stack_exhausted(SrcLoc where);
+
+// ---- the evaluator's hot path ------------------------------------------------
+// Inline: eval() pays one decrement per step.
+namespace limits_detail {
+extern int64_t fuel;          // steps left before the next checkpoint
+extern uint64_t expr_ceiling; // the arena size at which new nodes fail
+extern std::atomic<int> interrupt;
+void checkpoint(SrcLoc where);
+void expression_check(size_t count);
+} // namespace limits_detail
+
+// One evaluation step at `where`: a decrement, and a real check every few
+// thousand steps.
+inline void count_step(const SrcLoc &where) {
+  if (--limits_detail::fuel < 0) [[unlikely]]
+    limits_detail::checkpoint(where);
+}
+
+// The expression arena, holding `count` nodes, is about to make another.
+inline void check_expression_nodes(size_t count) {
+  if (count >= limits_detail::expr_ceiling ||
+      limits_detail::interrupt.load(std::memory_order_relaxed)) [[unlikely]]
+    limits_detail::expression_check(count);
+}
+
+} // namespace sicm
