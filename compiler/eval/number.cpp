@@ -653,6 +653,16 @@ Value exact_integer_expt(Value b, Value e) {
     return make_rational(base);
   }
   unsigned long n = mpz_get_ui(exponent);
+  // GMP aborts the process when a result outgrows its size field, and a
+  // result of more than kMaxPowerBits bits (32 MiB) is a mistake, not a
+  // computation: refuse it as MIT refuses what it cannot allocate.
+  constexpr double kMaxPowerBits = 268435456.0;
+  double bits = static_cast<double>(std::max(mpz_sizeinbase(mpq_numref(base.v), 2),
+                                             mpz_sizeinbase(mpq_denref(base.v), 2)));
+  if (bits > 1 && (bits - 1) * static_cast<double>(n) > kMaxPowerBits)
+    runtime_error(current_call_loc(),
+                  "expt: the exact result would have more than 268435456 bits; use an inexact "
+                  "base (exact->inexact) for a flonum result");
   mpz_pow_ui(mpq_numref(out.v), mpq_numref(base.v), n);
   mpz_pow_ui(mpq_denref(out.v), mpq_denref(base.v), n);
   if (negative) mpq_inv(out, out);
