@@ -16,12 +16,18 @@ BUILD    ?= build
 CXX      ?= g++
 CC       ?= gcc
 
-WARN      := -Wall -Wextra $(if $(WERROR),-Werror)
+# GCC's sanitizer instrumentation makes -Wmaybe-uninitialized report false
+# positives inside libstdc++'s <regex>, so SANITIZE=1 turns that one off.
+WARN      := -Wall -Wextra $(if $(WERROR),-Werror) $(if $(SANITIZE),-Wno-maybe-uninitialized)
 OPT       ?= -O2
 comma     := ,
 SANFLAGS  := $(if $(SANITIZE),-fsanitize=address$(comma)undefined -fno-omit-frame-pointer)
+# The generated C (JIT kernels, `sicm build` executables) is compiled with the
+# same flags, so that a sanitized sicm loads sanitized kernels and a sanitized
+# libsicmrt.a is linked with its sanitizer runtimes.
+SANDEF    := $(if $(SANITIZE),-DSICM_SANITIZE_FLAGS='"$(SANFLAGS)"')
 CPPFLAGS  := -Icompiler -Iruntime/include -MMD -MP
-CXXFLAGS  := -std=c++20 $(OPT) -g $(WARN) $(SANFLAGS)
+CXXFLAGS  := -std=c++20 $(OPT) -g $(WARN) $(SANFLAGS) $(SANDEF)
 CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(SANFLAGS)
 LDFLAGS   := $(SANFLAGS)
 LIBS      := -lflint -lgc -lgmp -lreadline -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -lm -lpthread -ldl
@@ -78,9 +84,29 @@ unit: $(UNITBIN)
 deps:
 	@scripts/install-deps
 
+# How sanitized programs run under `make check SANITIZE=1` (every process the
+# tests start inherits it: sicm, the unit tests, built executables):
+#   abort_on_error=1            a finding ends the program with SIGABRT, which the
+#                               runner always counts as a failure (ASan's usual
+#                               exit status 1 could pass as an expected error)
+#   halt_on_error=1             UBSan stops at its first finding instead of
+#                               printing it and going on with status 0
+#   print_stacktrace=1          UBSan shows where the undefined behaviour was
+#   detect_leaks=0              the Boehm GC owns the heap and frees by
+#                               collecting, so LeakSanitizer would report the
+#                               malloc'd memory that only the GC heap refers to
+#   detect_stack_use_after_return=0
+#                               the GC scans the stacks for pointers; ASan's fake
+#                               stack frames would hide live objects from it
+#   SICM_TEST_TIMEOUT_SCALE=10  sanitized code computes 5-10 times slower
+SANENV := $(if $(SANITIZE),\
+  ASAN_OPTIONS=abort_on_error=1:detect_leaks=0:detect_stack_use_after_return=0 \
+  UBSAN_OPTIONS=halt_on_error=1:abort_on_error=1:print_stacktrace=1 \
+  SICM_TEST_TIMEOUT_SCALE=10)
+
 check: deps
 	@$(MAKE) --no-print-directory all $(UNITBIN)
-	@python3 tests/run --sicm $(SICM) --unit $(UNITBIN) $(if $(UPDATE),--update)
+	@$(SANENV) python3 tests/run --sicm $(SICM) --unit $(UNITBIN) $(if $(UPDATE),--update)
 
 demo: deps
 	@$(MAKE) --no-print-directory all

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <vector>
 
+#include "codegen/jit.hpp"
 #include "codegen/residual_emit.hpp"
 #include "eval/build.hpp"
 #include "eval/core.hpp"
@@ -149,6 +150,8 @@ int build_program(const BuildOptions &o) {
   argv.insert(argv.end(),
               {"-std=c11", o.opt_level, "-o", o.output, c_path, "-I" + include_dir, library,
                "-lsundials_cvode", "-lsundials_nvecserial", "-lgsl", "-lgslcblas", "-lm"});
+  std::vector<std::string> sanitize = sanitizer_flags();
+  argv.insert(argv.begin() + 1, sanitize.begin(), sanitize.end());
   int status = run(argv);
   if (!keep) std::remove(c_path.c_str());
   if (status != 0) {

@@ -31,6 +31,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <sstream>
 #include <unordered_map>
 #include <vector>
 
@@ -309,6 +310,16 @@ std::vector<std::string> compiler_words() {
 
 const char *const kFlags[] = {"-std=c11", "-O2", "-fPIC", "-shared"};
 
+// kFlags and, in a sanitized build, the sanitizer flags, so that the kernels
+// a sanitized sicm loads are checked too (and cached apart from the others,
+// since the flags are part of the key).
+std::vector<std::string> compile_flags() {
+  std::vector<std::string> flags(std::begin(kFlags), std::end(kFlags));
+  for (std::string &f : sanitizer_flags())
+    flags.push_back(std::move(f));
+  return flags;
+}
+
 // What, besides the source, decides the object: the command line and the
 // machine (a home directory may be shared by machines of several kinds).
 std::string compiler_identity(const std::vector<std::string> &cc) {
@@ -319,8 +330,8 @@ std::string compiler_identity(const std::vector<std::string> &cc) {
   std::string id;
   for (const std::string &w : cc)
     id += w + ' ';
-  for (const char *f : kFlags)
-    id += std::string(f) + ' ';
+  for (const std::string &f : compile_flags())
+    id += f + ' ';
   return id + '\0' + machine;
 }
 
@@ -442,7 +453,8 @@ bool compile_to(const std::string &dir, const std::string &name, const Digest &k
     return false;
   }
   std::vector<std::string> argv = cc;
-  argv.insert(argv.end(), std::begin(kFlags), std::end(kFlags));
+  std::vector<std::string> flags = compile_flags();
+  argv.insert(argv.end(), flags.begin(), flags.end());
   argv.insert(argv.end(), {"-o", out, src, "-lm"});
   int err = 0;
   int status = run_compiler(argv, log, &err);
@@ -489,6 +501,18 @@ void *load_entry(const std::string &so, const Digest &key, std::string *error) {
 }
 
 } // namespace
+
+std::vector<std::string> sanitizer_flags() {
+#ifdef SICM_SANITIZE_FLAGS
+  std::vector<std::string> words;
+  std::istringstream in(SICM_SANITIZE_FLAGS);
+  for (std::string w; in >> w;)
+    words.push_back(w);
+  return words;
+#else
+  return {};
+#endif
+}
 
 uint64_t jit_compiler_runs() {
   return g_compiler_runs.load();

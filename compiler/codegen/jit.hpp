@@ -1,7 +1,7 @@
 // The JIT: C source to a loaded shared object by the system C compiler, cached by content hash.
 //
 // The compiler is $CC (split on blanks) or `cc`, run without a shell as
-//   CC -std=c11 -O2 -fPIC -shared -o OUT.so SRC.c -lm
+//   CC -std=c11 -O2 -fPIC -shared [SANITIZER FLAGS] -o OUT.so SRC.c -lm
 // (no -ffast-math: kernels keep IEEE semantics). Objects are cached in
 // $XDG_CACHE_HOME/sicm, else ~/.cache/sicm, else a private temporary
 // directory, as KEY.so where KEY is the SHA-256 of the source, the compiler
@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace sicm {
 
@@ -32,6 +33,12 @@ namespace sicm {
 // receives the shared object's path. Thread-safe.
 void *jit_load(const std::string &c_source, const std::string &symbol, std::string *so_path,
                std::string *why_not);
+
+// The sanitizer flags sicm itself was built with (SANITIZE=1 in the
+// Makefile defines SICM_SANITIZE_FLAGS), else none. Generated C is compiled
+// with them too: a sanitized process should load checked kernels, and an
+// executable linked with a sanitized libsicmrt.a needs the sanitizer runtimes.
+std::vector<std::string> sanitizer_flags();
 
 // How many times this process has started the C compiler (tests use it to
 // see that the cache works).
