@@ -1092,8 +1092,18 @@ Value select_values(Value test, Value a, Value b) {
 struct Assignment {
   Value *place; // a global's value or a frame slot
   Value before, after;
+  uint32_t serial = 0; // the frame's serial (0 for a global)
 };
+
 std::vector<gcvec<Assignment> *> g_undo; // logs hold Values: collected memory
+// g_frame_serial when each log began: a local variable of a frame made
+// later belongs to the alternative (or loop body) itself and is not logged.
+std::vector<uint32_t> g_undo_serials;
+
+// Add a to the innermost log, if its variable is older than the log.
+void log_assignment(const Assignment &a) {
+  if (!g_undo.empty() && a.serial <= g_undo_serials.back()) g_undo.back()->push_back(a);
+}
 
 // Evaluate one alternative under a run-time test.
 Value speculate(const std::function<Value()> &alternative) {
@@ -1122,9 +1132,11 @@ Value alternative(std::vector<RStmt> &block, gcvec<Assignment> &log,
                   const std::function<Value()> &eval_it) {
   g_blocks.push_back(&block);
   g_undo.push_back(&log);
+  g_undo_serials.push_back(g_frame_serial);
   auto restore = [&] {
     g_blocks.pop_back();
     g_undo.pop_back();
+    g_undo_serials.pop_back();
     for (auto a = log.rbegin(); a != log.rend(); ++a) {
       a->after = *a->place;
       *a->place = a->before;
@@ -1160,7 +1172,7 @@ Value branch(Value test, const std::function<Value()> &then_fn,
   if (!g_undo.empty()) { // an enclosing alternative undoes what these did, too
     for (const auto *log : {&then_log, &else_log})
       for (const Assignment &x : *log)
-        g_undo.back()->push_back(Assignment{x.place, x.before, x.before});
+        log_assignment(Assignment{x.place, x.before, x.before, x.serial});
   }
   if (!then_block.empty() || !else_block.empty()) {
     RStmt s{RKind::If};
@@ -1183,7 +1195,11 @@ Value branch(Value test, const std::function<Value()> &then_fn,
     for (const Assignment &x : else_log)
       if (x.place == g) after_else = x.after;
     Value merged = cell_of(g) >= 0 ? *g : select_values(test, after_then, after_else);
-    if (!g_undo.empty()) g_undo.back()->push_back(Assignment{g, *g, merged});
+    uint32_t serial = 0;
+    for (const auto *log : {&then_log, &else_log})
+      for (const Assignment &x : *log)
+        if (x.place == g) serial = x.serial;
+    log_assignment(Assignment{g, *g, merged, serial});
     *g = merged;
   }
   if (calls) read_cells();
@@ -1209,7 +1225,7 @@ Value hook_logic(Value test, Node *n, uint32_t from, bool is_and, Frame *env) {
 // call to the next: a cell. `may_create`: it may become one here.
 Value assign(Value *place, const std::string &name, Value v, SrcLoc loc, bool outer,
              bool may_create, Frame *frame) {
-  if (!g_undo.empty()) g_undo.back()->push_back(Assignment{place, *place, v});
+  log_assignment(Assignment{place, *place, v, frame ? frame->serial : 0});
   int cell = cell_of(place);
   if (!outer) {
     if (cell < 0) return v; // an ordinary assignment at compile time
@@ -1300,11 +1316,7 @@ bool result_leaves(Value v, gcvec<Value> &out) {
     return true;
   }
   if (!contains_dynamic(v) && !is_pair(v) && !container_items_of(v)) return true; // kept as is
-  if (is_pair(v) || is_null(v)) {
-    for (; is_pair(v); v = cdr(v))
-      if (!result_leaves(car(v), out)) return false;
-    return is_null(v);
-  }
+  if (is_pair(v)) return result_leaves(car(v), out) && result_leaves(cdr(v), out);
   size_t len;
   Value *items = container_items(v, &len);
   if (!items) return false;
@@ -1317,11 +1329,9 @@ bool result_leaves(Value v, gcvec<Value> &out) {
 Value result_like(Value shape, const Value *&leaves) {
   if (is_scalar(shape)) return *leaves++;
   if (!contains_dynamic(shape) && !is_pair(shape) && !container_items_of(shape)) return shape;
-  if (is_pair(shape) || is_null(shape)) {
-    gcvec<Value> items;
-    for (Value v = shape; is_pair(v); v = cdr(v))
-      items.push_back(result_like(car(v), leaves));
-    return list_from(items.data(), items.size());
+  if (is_pair(shape)) {
+    Value a = result_like(car(shape), leaves);
+    return cons(a, result_like(cdr(shape), leaves));
   }
   size_t len;
   Value *items = container_items(shape, &len);
@@ -1364,11 +1374,8 @@ std::vector<ActiveLoop *> g_loops; // loops whose bodies are being evaluated, in
 bool same_shape(Value a, Value b) {
   if (is_scalar(a) || is_scalar(b)) return is_scalar(a) && is_scalar(b);
   if (!is_pair(a) && !container_items_of(a) && !contains_dynamic(a)) return eqv(a, b);
-  if (is_pair(a) || is_null(a) || is_pair(b) || is_null(b)) {
-    for (; is_pair(a) && is_pair(b); a = cdr(a), b = cdr(b))
-      if (!same_shape(car(a), car(b))) return false;
-    return is_null(a) && is_null(b);
-  }
+  if (is_pair(a) || is_pair(b))
+    return is_pair(a) && is_pair(b) && same_shape(car(a), car(b)) && same_shape(cdr(a), cdr(b));
   size_t la = 0, lb = 0;
   Value *x = container_items(a, &la), *y = container_items(b, &lb);
   if (!x || !y || la != lb || a.tag != b.tag) return false;
@@ -1428,11 +1435,13 @@ public:
     g_loops.push_back(loop);
     g_blocks.push_back(block);
     g_undo.push_back(&log_);
+    g_undo_serials.push_back(g_frame_serial);
   }
   ~LoopAttempt() {
     g_loops.resize(nloops_);
     g_blocks.resize(nblocks_);
     g_undo.resize(nundo_);
+    g_undo_serials.resize(nundo_);
   }
   // Forget everything the attempt made.
   void roll_back() {
@@ -1488,7 +1497,7 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
     if (!recursive) {
       if (!g_undo.empty()) // an enclosing alternative undoes these assignments too
         for (const Assignment &a : assigned)
-          g_undo.back()->push_back(a);
+          log_assignment(a);
       for (RStmt &x : body)
         current_block().push_back(std::move(x));
       *out = v;
@@ -1550,7 +1559,7 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
     if (retry) continue;
     if (!g_undo.empty()) // an enclosing alternative undoes these assignments too
       for (const Assignment &a : assigned)
-        g_undo.back()->push_back(a);
+        log_assignment(a);
     bool calls = block_calls(body);
     RStmt s{loop.continued ? RKind::Loop : RKind::If};
     for (const LoopParam &p : loop.params) {
