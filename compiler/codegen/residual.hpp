@@ -95,6 +95,7 @@ struct RStmt {
   int plot = -1;                             // plot statements: the plot's number
   int callee = -1;                           // the function a numerical statement calls
   int monitor = -1;                          // Evolve: the monitor function, or -1
+  int jacobian = -1;                         // Advance, Evolve: (D sysder) for implicit methods
   int cell = -1;                             // SetCell, Let of ReadCell
   double number = 0;                         // a tolerance
   bool time_first = false, rate_one = false; // Advance, Evolve

@@ -189,7 +189,7 @@ private:
       if (s.kind == RKind::Print) needs.insert(s.var);
       for (ExprId a : s.args)
         refs_of(a, &s, needs);
-      for (int callee : {s.callee, s.monitor})
+      for (int callee : {s.callee, s.monitor, s.jacobian})
         if (callee >= 0) needs.insert(captures_[callee].begin(), captures_[callee].end());
       live.insert(needs.begin(), needs.end());
       used.insert(needs.begin(), needs.end());
@@ -278,7 +278,7 @@ private:
   std::string ode(const RStmt &s, size_t dim) {
     return "(sicm_drive_ode){" + s.method + ", " + closure(s.callee) + ", " + std::to_string(dim) +
            ", " + (s.time_first ? "1" : "0") + ", " + (s.rate_one ? "1" : "0") + ", " +
-           c_double_literal(s.number) + "}";
+           c_double_literal(s.number) + ", " + closure(s.jacobian) + "}";
   }
 
   // Declarations of the used outputs of a statement from an array.

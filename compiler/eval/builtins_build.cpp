@@ -880,6 +880,35 @@ void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
       expr_is_exact_one(d0) || (expr_kind(d0) == ExprKind::Flonum && expr_node(d0).d == 1.0);
 }
 
+// For the implicit methods, the Jacobian (D sysder) traced as a function of
+// the state too (its leaves: d f_i / d y_j at j * dim + i), as sicm run
+// compiles it; left to finite differences when it cannot be traced.
+void trace_jacobian(Value sysder, Value state, RStmt &s) {
+  if (s.method != "sicm_ode_step_msbdf" && s.method != "sicm_ode_step_cvode_bdf") return;
+  Symbol *d = intern("D").symbol();
+  if (!d->bound) return;
+  size_t nfunctions = g_prog->functions.size(), nvars = g_prog->vars.size();
+  try {
+    FunctionScope scope("jacobian");
+    Value x = input_like(state);
+    Value dsys = apply_procedure(d->global, &sysder, 1);
+    Value j = apply_procedure(dsys, &x, 1);
+    gcvec<Value> leaves;
+    state_leaves(j, leaves);
+    size_t n = current().inputs.size();
+    if (leaves.size() != n * n) return;
+    for (Value leaf : leaves)
+      current().outputs.push_back(expr_of(simplify_value(leaf), "jacobian"));
+    s.jacobian = scope.id();
+  } catch (const Error &) {
+    for (size_t v = nvars; v < g_prog->vars.size(); ++v)
+      g_var_of.erase(g_prog->vars[v].sym);
+    g_prog->functions.resize(nfunctions);
+    g_prog->vars.resize(nvars);
+    s.jacobian = -1;
+  }
+}
+
 Value state_result(Value state, RStmt &s) {
   gcvec<Value> leaves;
   state_leaves(state, leaves);
@@ -920,6 +949,7 @@ Value advance(NativeProc *self, Value *a, int n) {
   state_args(a[0], s, who);
   s.args.push_back(expr_of(a[1], who));
   trace_system(self->a, a[0], s, who);
+  trace_jacobian(self->a, a[0], s);
   Value r = state_result(a[0], s);
   emit(std::move(s));
   return r;
@@ -941,6 +971,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   s.args.push_back(expr_of(a[2], who));
   s.args.push_back(expr_of(a[3], who));
   trace_system(self->a, a[0], s, who);
+  trace_jacobian(self->a, a[0], s);
   Value monitor = a[1];
   if (!is_procedure(monitor)) wrong_type(monitor, 2, who);
   {

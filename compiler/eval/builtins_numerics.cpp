@@ -374,7 +374,9 @@ private:
 struct OdeCallback : Callback {
   Value sysder;
   const StateShape *shape;
-  const Kernel *kernel = nullptr; // sysder itself when it is a kernel on the state's shape
+  const Kernel *kernel = nullptr;   // sysder itself when it is a kernel on the state's shape
+  const Kernel *jacobian = nullptr; // (D sysder) on the state's shape, for implicit methods
+  std::vector<double> jacobian_out;
   // Every derivative computed so far had exactly 1 as its time component:
   // then the time component of the solution is exactly the integrator's
   // time, and results carry that instead of the sum of the steps.
@@ -406,6 +408,24 @@ int call_sysder(double, const double *y, double *dydt, void *data) {
     cb->error = std::current_exception();
     return 1;
   }
+}
+
+// The analytic Jacobian of a compiled system derivative: the kernel of
+// (D sysder) gives d f_i / d y_j at out[j * dim + i] (a down structure over
+// the state's components of up structures of the derivative's), the runtime
+// wants it row-major. The rhs does not depend on the integrator's time
+// (time is a state component), so df/dt is 0.
+int call_jacobian(double, const double *y, double *dfdy, double *dfdt, void *data) {
+  auto *cb = static_cast<OdeCallback *>(data);
+  size_t n = cb->shape->dim();
+  cb->jacobian_out.resize(n * n);
+  kernel_call(cb->jacobian, y, cb->jacobian_out.data());
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j)
+      dfdy[i * n + j] = cb->jacobian_out[j * n + i];
+    dfdt[i] = 0.0;
+  }
+  return 0;
 }
 
 struct OdeDeleter {
@@ -510,6 +530,22 @@ const Kernel *auto_kernel(Value sysder, Value state, size_t dim) {
   return k;
 }
 
+// A kernel of (D sysder) on states shaped like `state`, or null (the
+// derivative cannot be differentiated and traced, or no C compiler).
+const Kernel *jacobian_kernel(Value sysder, Value state, size_t dim) {
+  if (!kernels_enabled()) return nullptr;
+  Symbol *d = intern("D").symbol();
+  if (!d->bound) return nullptr;
+  try {
+    Value dsys = apply_procedure(d->global, &sysder, 1);
+    std::string why;
+    const Kernel *k = compile_kernel(dsys, list({state}), "jacobian", &why);
+    return k && k->nin == dim && k->nout == dim * dim ? k : nullptr;
+  } catch (const Error &) {
+    return nullptr;
+  }
+}
+
 // ---- one integration problem ----------------------------------------------------
 
 // A state, flattened, with its shape and the system derivative's callback.
@@ -536,6 +572,12 @@ struct OdeProblem {
   OdePtr make_integrator(const sicm_ode_step_type *T, double eps) {
     OdePtr ode(sicm_ode_alloc(T, shape.dim(), call_sysder, &cb, eps, eps));
     if (!ode) numeric_error(cb.loc, cb.who, reason_of(g_runtime_message));
+    // Implicit methods solve with the Jacobian: from a kernel of (D sysder)
+    // when the derivative itself compiled, else by finite differences.
+    if ((T == sicm_ode_step_msbdf || T == sicm_ode_step_cvode_bdf) && cb.kernel) {
+      cb.jacobian = jacobian_kernel(cb.sysder, shape.build(y.data()), shape.dim());
+      if (cb.jacobian) sicm_ode_set_jacobian(ode.get(), call_jacobian);
+    }
     return ode;
   }
 

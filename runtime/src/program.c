@@ -183,13 +183,6 @@ static double vector_of(const double *x, void *c) {
   return out;
 }
 
-static int rhs_of(double t, const double *y, double *dydt, void *c) {
-  (void)t;
-  const sicm_closure *k = c;
-  k->fn(y, dydt, k->p);
-  return 0;
-}
-
 static void fail_with_status(const sicm_site *site, const char *who) {
   sicm_program_fail(site, who, reason_text());
 }
@@ -336,20 +329,58 @@ double sicm_drive_bisect(const sicm_site *site, sicm_closure f, double x0, doubl
 typedef struct {
   sicm_ode *o;
   sicm_closure sysder;
+  sicm_closure jacobian;
+  size_t dim;
+  double *jac_out; /* dim * dim, the kernel's column-major Jacobian */
 } integrator;
+
+/* The runtime's Jacobian callback from a kernel of (D sysder) (see
+ * sicm_drive_ode); the rhs does not depend on the integrator's time. */
+static int jacobian_of(double t, const double *y, double *dfdy, double *dfdt, void *c) {
+  (void)t;
+  const integrator *it = c;
+  size_t n = it->dim;
+  it->jacobian.fn(y, it->jac_out, it->jacobian.p);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j)
+      dfdy[i * n + j] = it->jac_out[j * n + i];
+    dfdt[i] = 0.0;
+  }
+  return 0;
+}
+
+static int rhs_of_integrator(double t, const double *y, double *dydt, void *c) {
+  (void)t;
+  const integrator *it = c;
+  it->sysder.fn(y, dydt, it->sysder.p);
+  return 0;
+}
 
 static void open_integrator(const sicm_site *site, const char *who, const sicm_drive_ode *ode,
                             integrator *it) {
   it->sysder = ode->sysder;
-  it->o = sicm_ode_alloc(ode->method, ode->dim, rhs_of, &it->sysder, ode->tol, ode->tol);
+  it->jacobian = ode->jacobian;
+  it->dim = ode->dim;
+  it->jac_out = NULL;
+  it->o = sicm_ode_alloc(ode->method, ode->dim, rhs_of_integrator, it, ode->tol, ode->tol);
   if (!it->o) fail_with_status(site, who);
+  if (it->jacobian.fn) {
+    it->jac_out = malloc(ode->dim * ode->dim * sizeof *it->jac_out);
+    if (!it->jac_out) sicm_program_fail(site, who, "out of memory");
+    sicm_ode_set_jacobian(it->o, jacobian_of);
+  }
+}
+
+static void close_integrator(integrator *it) {
+  sicm_ode_free(it->o);
+  free(it->jac_out);
 }
 
 static void evolve_to(const sicm_site *site, const char *who, integrator *it, double *t, double t1,
                       double *y) {
   if (sicm_ode_evolve(it->o, t, t1, y) != SICM_SUCCESS) {
     snprintf(last_reason, sizeof last_reason, "%s", sicm_ode_last_error(it->o));
-    sicm_ode_free(it->o);
+    close_integrator(it);
     fail_with_status(site, who);
   }
 }
@@ -365,7 +396,7 @@ void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double
   double t = start_time(ode, y), t1 = t + dt;
   evolve_to(site, who, &it, &t, t1, y);
   if (ode->time_first && ode->rate_one) y[0] = t1;
-  sicm_ode_free(it.o);
+  close_integrator(&it);
 }
 
 void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure monitor,
@@ -392,6 +423,6 @@ void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_cl
     }
   }
   if (ode->time_first && ode->rate_one) y[0] = t_final;
-  sicm_ode_free(it.o);
+  close_integrator(&it);
   free(shown);
 }

@@ -123,6 +123,9 @@ typedef struct {
   int time_first;
   int rate_one;
   double tol;
+  /* For implicit methods, a kernel of (D sysder): d f_i / d y_j at
+   * out[j * dim + i]; NULL fn for finite differences. */
+  sicm_closure jacobian;
 } sicm_drive_ode;
 
 /* ((state-advancer ...) state dt tol): y (dim leaves) becomes the state dt
