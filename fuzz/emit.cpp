@@ -63,6 +63,19 @@ constexpr double kRelTol = 1e-12;
 constexpr double kBoundFactor = 8;
 
 std::string g_dir; // a private temporary directory for the C and the objects
+
+// What the checks did, printed at exit (for docs/reliability.md).
+struct Stats {
+  unsigned long kernels = 0, simplified = 0, outputs = 0, compared = 0, by_bound = 0, skipped = 0;
+} g_stats;
+
+void print_stats() {
+  const Stats &s = g_stats;
+  std::fprintf(stderr,
+               "emit stats: %lu kernels compiled (%lu simplified), %lu output values: %lu "
+               "compared (%lu within the error bound only), %lu skipped\n",
+               s.kernels, s.simplified, s.outputs, s.compared, s.by_bound, s.skipped);
+}
 gcvec<Symbol *> g_inputs;
 unsigned long g_serial = 0;
 
@@ -236,21 +249,29 @@ void check_kernel(const Trace &t, uint64_t seed) {
     std::vector<Value> memo;
     std::vector<bool> done;
     for (size_t j = 0; j < t.outputs.size(); ++j) {
+      ++g_stats.outputs;
       fuzz::Approx bound = numeric.eval(t.outputs[j]);
       // A value the interpreter cannot give (it raises for sqrt of a
       // negative) or an infinity on the way: not comparable.
-      if (!numeric.all_finite()) break; // later outputs share the nodes that were not
+      if (!numeric.all_finite()) { // later outputs may share the nodes that were not
+        g_stats.skipped += t.outputs.size() - j;
+        break;
+      }
       double want;
       try {
         want = to_double(interpret(t.outputs[j], point, memo, done));
       } catch (const Error &) {
+        g_stats.skipped += t.outputs.size() - j;
         break; // the interpreter refuses this point
       }
       double got = out[j];
       double diff = std::fabs(got - want);
-      if (std::isfinite(want) && (diff <= kRelTol * std::max(std::fabs(got), std::fabs(want)) ||
-                                  diff <= kBoundFactor * bound.e))
+      bool relative = diff <= kRelTol * std::max(std::fabs(got), std::fabs(want));
+      if (std::isfinite(want) && (relative || diff <= kBoundFactor * bound.e)) {
+        ++g_stats.compared;
+        g_stats.by_bound += !relative;
         continue;
+      }
       char buf[512];
       std::snprintf(buf, sizeof buf,
                     "output %zu at (%.17g, %.17g, %.17g, %.17g): kernel %.17g, interpreter "
@@ -275,6 +296,7 @@ void fuzz_setup() {
   if (!mkdtemp(buf.data())) fuzz::fail("cannot make a temporary directory");
   g_dir = buf.data();
   std::atexit([] { rmdir(g_dir.c_str()); });
+  std::atexit(print_stats);
   for (int i = 0; i < kInputs; ++i)
     g_inputs.push_back(make_uninterned_symbol("x" + std::to_string(i)).symbol());
 }
@@ -296,6 +318,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       return 0; // a division by something that simplifies to zero
     }
   }
+  ++g_stats.kernels;
+  g_stats.simplified += simplified;
   check_kernel(t, fuzz::hash_bytes(data, size));
   return 0;
 }

@@ -41,8 +41,11 @@ bool symbol_reads_back(Symbol *s) {
   return ok;
 }
 
+// Data with no readable written form: the end-of-file object (#!eof)
+// writes as #[eof], in MIT Scheme too.
 bool has_unwritable_symbol(Value d, int depth = 0) {
   if (depth > kMaxReadDepth) return false;
+  if (d.is(Tag::Eof)) return true;
   if (d.is(Tag::Symbol)) return !symbol_reads_back(d.symbol());
   if (d.is(Tag::Pair)) {
     for (; d.is(Tag::Pair); d = d.pair()->cdr)
