@@ -2,6 +2,7 @@
 #include "common.hpp"
 
 #include <pthread.h>
+#include <signal.h>
 
 #include <algorithm>
 #include <cfloat>
@@ -38,13 +39,34 @@ struct Args {
   int status;
 };
 
+// libFuzzer's -timeout is a SIGALRM whose handler acts only on the thread
+// that runs the inputs; the signal goes to any thread that does not block
+// it. So every thread blocks it (main() before the collector starts its
+// threads; libFuzzer's own thread inherits the mask) except this one, which
+// unblocks it once the inputs start.
+void set_alarm_blocked(bool blocked) {
+  sigset_t alarm;
+  sigemptyset(&alarm);
+  sigaddset(&alarm, SIGALRM);
+  pthread_sigmask(blocked ? SIG_BLOCK : SIG_UNBLOCK, &alarm, nullptr);
+}
+
+int run_one(const uint8_t *data, size_t size) {
+  static bool unblocked = false;
+  if (!unblocked) {
+    set_alarm_blocked(false);
+    unblocked = true;
+  }
+  return LLVMFuzzerTestOneInput(data, size);
+}
+
 void *fuzz_thread(void *p) {
   Args *a = static_cast<Args *>(p);
   char base;
   g_stack_base = &base;
   fuzz::reset_stack_limit();
   fuzz_setup();
-  a->status = LLVMFuzzerRunDriver(&a->argc, &a->argv, LLVMFuzzerTestOneInput);
+  a->status = LLVMFuzzerRunDriver(&a->argc, &a->argv, run_one);
   return nullptr;
 }
 
@@ -59,6 +81,7 @@ extern "C" const char *__asan_default_options() {
 }
 
 int main(int argc, char **argv) {
+  set_alarm_blocked(true);
   GC_INIT();
   Args args{argc, argv, 0};
   pthread_attr_t attr;

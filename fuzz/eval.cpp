@@ -26,6 +26,8 @@
 // later inputs run. Not restored: a definition of a name the program
 // computes (string->symbol and eval), and state inside values (a set-car! on
 // a list the library holds). Inputs the reader rejects are skipped.
+#include <pthread.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -124,6 +126,10 @@ std::chrono::steady_clock::time_point g_deadline;
 int g_deadline_ms = kDeadlineMs;
 
 void watchdog() {
+  sigset_t alarm; // libFuzzer's -timeout must reach the fuzzing thread, not this one
+  sigemptyset(&alarm);
+  sigaddset(&alarm, SIGALRM);
+  pthread_sigmask(SIG_BLOCK, &alarm, nullptr);
   std::unique_lock<std::mutex> lock(g_mutex);
   for (;;) {
     if (g_generation % 2 == 0) {
