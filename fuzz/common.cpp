@@ -1,0 +1,319 @@
+// The fuzz targets' main() and shared helpers (see common.hpp).
+#include "common.hpp"
+
+#include <pthread.h>
+#include <signal.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <unordered_set>
+
+#include "eval/number.hpp"
+#include "eval/procedure.hpp"
+#include "eval/value.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+extern "C" int LLVMFuzzerRunDriver(int *argc, char ***argv,
+                                   int (*callback)(const uint8_t *data, size_t size));
+
+namespace {
+
+// The stack reserved for evaluation, and the part kept free below the guard
+// for primitives. compiler/main.cpp reserves 256 MiB; here it is 60 MiB,
+// because AddressSanitizer declines to clear its records of a stack larger
+// than 64 MiB when an exception unwinds it, and then reports false
+// stack-buffer-overflows (google/sanitizers issue 189). So deep recursion
+// stops earlier here than in sicm (at about a fifth of the depth, less the
+// sanitizer's larger frames); the error it gives is the same.
+constexpr size_t kStackBytes = size_t(60) << 20;
+constexpr size_t kStackGuardMargin = size_t(16) << 20;
+
+char *g_stack_base;
+
+struct Args {
+  int argc;
+  char **argv;
+  int status;
+};
+
+// libFuzzer's -timeout is a SIGALRM whose handler acts only on the thread
+// that runs the inputs; the signal goes to any thread that does not block
+// it. So every thread blocks it (main() before the collector starts its
+// threads; libFuzzer's own thread inherits the mask) except this one, which
+// unblocks it once the inputs start.
+void set_alarm_blocked(bool blocked) {
+  sigset_t alarm;
+  sigemptyset(&alarm);
+  sigaddset(&alarm, SIGALRM);
+  pthread_sigmask(blocked ? SIG_BLOCK : SIG_UNBLOCK, &alarm, nullptr);
+}
+
+int run_one(const uint8_t *data, size_t size) {
+  static bool unblocked = false;
+  if (!unblocked) {
+    set_alarm_blocked(false);
+    unblocked = true;
+  }
+  return LLVMFuzzerTestOneInput(data, size);
+}
+
+void *fuzz_thread(void *p) {
+  Args *a = static_cast<Args *>(p);
+  char base;
+  g_stack_base = &base;
+  fuzz::reset_stack_limit();
+  fuzz_setup();
+  a->status = LLVMFuzzerRunDriver(&a->argc, &a->argv, run_one);
+  return nullptr;
+}
+
+} // namespace
+
+// LeakSanitizer is off: symbols, and the std::strings inside them, live in
+// memory of the garbage collector, which it does not scan, so every symbol's
+// name would be reported as leaked. (Memory the program really loses is the
+// collector's business, not the sanitizer's.)
+extern "C" const char *__asan_default_options() {
+  return "detect_leaks=0";
+}
+
+int main(int argc, char **argv) {
+  set_alarm_blocked(true);
+  GC_INIT();
+  Args args{argc, argv, 0};
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, kStackBytes);
+  pthread_t thread;
+  if (pthread_create(&thread, &attr, fuzz_thread, &args) != 0) {
+    std::fprintf(stderr, "fuzz: cannot start the fuzzing thread\n");
+    return 1;
+  }
+  pthread_join(thread, nullptr);
+  return args.status;
+}
+
+namespace fuzz {
+
+void reset_stack_limit() {
+  sicm::set_stack_limit(g_stack_base, kStackBytes - kStackGuardMargin);
+}
+
+void fail(const std::string &what) {
+  std::fprintf(stderr, "\n==== fuzz property violated ====\n%s\n", what.c_str());
+  std::fflush(stderr);
+  std::abort();
+}
+
+uint64_t Rng::next() {
+  uint64_t z = (s_ += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+double Rng::uniform(double lo, double hi) {
+  return lo + (hi - lo) * (static_cast<double>(next() >> 11) * 0x1p-53);
+}
+
+uint64_t hash_bytes(const uint8_t *data, size_t size) {
+  uint64_t h = 1469598103934665603ULL; // FNV-1a
+  for (size_t i = 0; i < size; ++i)
+    h = (h ^ data[i]) * 1099511628211ULL;
+  return h;
+}
+
+using namespace sicm;
+
+namespace {
+
+using C = std::complex<double>;
+constexpr double kU = DBL_EPSILON / 2; // unit roundoff
+const C kNaN(NAN, NAN);
+
+bool finite(C z) {
+  return std::isfinite(z.real()) && std::isfinite(z.imag());
+}
+
+// f(a) with derivative df at a.
+Approx unary(C v, C df, const Approx &a) {
+  return {v, std::abs(df) * a.e + 2 * kU * std::abs(v)};
+}
+
+// z^k by repeated squaring, k >= 0.
+C ipow(C z, uint64_t k) {
+  C r = 1;
+  for (; k; k >>= 1, z *= z)
+    if (k & 1) r *= z;
+  return r;
+}
+
+C power(C b, int64_t k) {
+  if (k >= 0) return ipow(b, static_cast<uint64_t>(k));
+  return C(1) / ipow(b, 0 - static_cast<uint64_t>(k));
+}
+
+double number_error(double v) {
+  return v == std::trunc(v) && std::fabs(v) < 0x1p53 ? 0 : kU * std::fabs(v);
+}
+
+} // namespace
+
+Approx NumEval::eval(ExprId id) {
+  Approx r = node(id);
+  if (!finite(r.v) || !std::isfinite(r.e)) finite_ = false;
+  return r;
+}
+
+Approx NumEval::node(ExprId id) {
+  auto hit = memo_.find(id);
+  if (hit != memo_.end()) return hit->second;
+  Approx r;
+  const ExprNode n = expr_node(id);
+  switch (n.kind) {
+  case ExprKind::Rational: {
+    double v = to_double(expr_number_value(id));
+    r = {v, number_error(v)};
+    break;
+  }
+  case ExprKind::Flonum: r = {n.d, number_error(n.d)}; break; // rounded by the simplifier, perhaps
+  case ExprKind::Symbol: {
+    r = {kNaN, NAN};
+    for (size_t i = 0; i < symbols_.size(); ++i)
+      if (symbols_[i] == n.sym) r = {point_[i], 0};
+    break;
+  }
+  case ExprKind::Call: r = {kNaN, NAN}; break;
+  case ExprKind::Apply: {
+    std::vector<ExprId> ids = expr_arg_vector(id);
+    std::vector<Approx> a;
+    for (ExprId k : ids)
+      a.push_back(eval(k));
+    C x = a[0].v;
+    // The singular places of the operators: a denominator, the base of a
+    // negative or fractional power, the argument of sqrt and log.
+    auto near_singular = [](const Approx &t) { return t.e > 0.01 * std::abs(t.v); };
+    int64_t k0 = 0;
+    bool singular_arg =
+        (n.op == Op::Div && near_singular(a.back())) ||
+        ((n.op == Op::Sqrt || n.op == Op::Log) && near_singular(a[0])) ||
+        (n.op == Op::Expt && !(expr_get_int64(ids[1], &k0) && k0 >= 0) && near_singular(a[0]));
+    if (singular_arg) degenerate_ = true;
+    switch (n.op) {
+    case Op::Add: {
+      C s = 0;
+      double e = 0, mag = 0;
+      for (const Approx &t : a) {
+        s += t.v;
+        e += t.e;
+        mag += std::abs(s);
+      }
+      r = {s, e + kU * mag};
+      break;
+    }
+    case Op::Mul: {
+      C p = 1;
+      double e = 0;
+      for (size_t i = 0; i < a.size(); ++i) {
+        double others = 1;
+        for (size_t j = 0; j < a.size(); ++j)
+          if (j != i) others *= std::abs(a[j].v);
+        e += others * a[i].e;
+        p *= a[i].v;
+      }
+      r = {p, e + a.size() * 2 * kU * std::abs(p)};
+      break;
+    }
+    case Op::Sub: { // never built (I4)
+      C s = a.size() == 1 ? -x : x;
+      double e = a[0].e;
+      for (size_t i = 1; i < a.size(); ++i) {
+        s -= a[i].v;
+        e += a[i].e + kU * std::abs(s);
+      }
+      r = {s, e};
+      break;
+    }
+    case Op::Div: {
+      if (a.size() == 1) {
+        C q = C(1) / x;
+        r = {q, a[0].e / std::norm(x) + 2 * kU * std::abs(q)};
+      } else {
+        C q = x / a[1].v;
+        r = {q, a[0].e / std::abs(a[1].v) + std::abs(q / a[1].v) * a[1].e + 2 * kU * std::abs(q)};
+      }
+      break;
+    }
+    case Op::Expt: {
+      int64_t k;
+      if (expr_get_int64(ids[1], &k) && k > -64 && k < 64) {
+        C v = power(x, k);
+        C d = k == 0 ? C(0) : static_cast<double>(k) * power(x, k - 1);
+        double steps = 2 * (1 + std::log2(1 + std::fabs(static_cast<double>(k))));
+        r = {v, std::abs(d) * a[0].e + steps * kU * std::abs(v)};
+      } else {
+        C c = a[1].v, v = std::pow(x, c);
+        C db = c * std::pow(x, c - 1.0), dc = std::log(x) * v;
+        r = {v, std::abs(db) * a[0].e + std::abs(dc) * a[1].e + 4 * kU * std::abs(v)};
+      }
+      break;
+    }
+    case Op::Sqrt: {
+      C s = std::sqrt(x);
+      if (std::find(negative_.begin(), negative_.end(), id) != negative_.end()) s = -s;
+      r = unary(s, 0.5 / s, a[0]);
+      break;
+    }
+    case Op::Exp: r = unary(std::exp(x), std::exp(x), a[0]); break;
+    case Op::Log: r = unary(std::log(x), C(1) / x, a[0]); break;
+    case Op::Sin: r = unary(std::sin(x), std::cos(x), a[0]); break;
+    case Op::Cos: r = unary(std::cos(x), std::sin(x), a[0]); break;
+    case Op::Tan: {
+      C t = std::tan(x);
+      r = unary(t, 1.0 + t * t, a[0]);
+      break;
+    }
+    case Op::Asin: r = unary(std::asin(x), C(1) / std::sqrt(1.0 - x * x), a[0]); break;
+    case Op::Acos: r = unary(std::acos(x), C(1) / std::sqrt(1.0 - x * x), a[0]); break;
+    case Op::Atan:
+      if (a.size() == 1) {
+        r = unary(std::atan(x), C(1) / (1.0 + x * x), a[0]);
+      } else if (x.imag() == 0 && a[1].v.imag() == 0) {
+        double y = x.real(), xx = a[1].v.real(), v = std::atan2(y, xx);
+        r = {v, (std::fabs(xx) * a[0].e + std::fabs(y) * a[1].e) / (xx * xx + y * y) +
+                    2 * kU * std::fabs(v)};
+      } else {
+        r = {kNaN, NAN}; // atan2 of complex values: not needed
+      }
+      break;
+    case Op::Sinh: r = unary(std::sinh(x), std::cosh(x), a[0]); break;
+    case Op::Cosh: r = unary(std::cosh(x), std::sinh(x), a[0]); break;
+    case Op::Abs: r = {std::abs(x), a[0].e + kU * std::abs(x)}; break;
+    }
+    break;
+  }
+  }
+  if (!finite(r.v) || !std::isfinite(r.e)) finite_ = false;
+  memo_.emplace(id, r);
+  return r;
+}
+
+std::vector<ExprId> sqrt_nodes(ExprId root) {
+  std::vector<ExprId> out, stack{root};
+  std::unordered_set<ExprId> seen;
+  while (!stack.empty()) {
+    ExprId id = stack.back();
+    stack.pop_back();
+    if (!seen.insert(id).second || expr_kind(id) != ExprKind::Apply) continue;
+    if (expr_is_apply(id, Op::Sqrt)) out.push_back(id);
+    for (ExprId k : expr_arg_vector(id))
+      stack.push_back(k);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+} // namespace fuzz
