@@ -52,7 +52,7 @@ SICM    := $(BUILD)/sicm
 RTLIB   := $(BUILD)/libsicmrt.a
 UNITBIN := $(BUILD)/unit-tests
 
-.PHONY: all check demo examples install clean deps unit
+.PHONY: all check demo examples install clean deps unit fuzz-smoke
 all: $(SICM) $(RTLIB)
 
 $(BUILD)/%.o: %.cpp
@@ -119,6 +119,11 @@ demo: deps
 examples: deps
 	@$(MAKE) --no-print-directory all
 	@scripts/run-examples --sicm $(SICM) --out $(BUILD)/figures
+
+# The libFuzzer targets of fuzz/, each for a few thousand inputs (needs clang).
+fuzz-smoke: deps
+	@$(MAKE) --no-print-directory all
+	@scripts/fuzz smoke
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/sicm
