@@ -38,6 +38,7 @@
 #include "eval/limits.hpp"
 #include "eval/number.hpp"
 #include "eval/numerics_defaults.hpp"
+#include "eval/plot.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
@@ -574,14 +575,16 @@ size_t state_dimension(Value v) {
   return leaves.size();
 }
 
-// A value shaped like `shape` with leaves taken from *leaves in order.
-Value state_like(Value shape, const Value *&leaves) {
+// A container shaped like `shape` (a structure or a vector) whose parts are
+// part(item, leaves) of its items in order; a non-container takes the next leaf.
+using PartFn = Value (*)(Value shape, const Value *&leaves);
+Value state_like(Value shape, const Value *&leaves, PartFn part) {
   size_t len;
   Value *items = container_items(shape, &len);
   if (!items) return *leaves++;
   gcvec<Value> parts;
   for (size_t i = 0; i < len; ++i)
-    parts.push_back(state_like(items[i], leaves));
+    parts.push_back(part(items[i], leaves));
   if (is_structure(shape))
     return make_structure_from(as_structure(shape)->up, parts.data(), parts.size());
   Value v = make_vector(parts.size(), Value::fixnum(0));
@@ -590,9 +593,13 @@ Value state_like(Value shape, const Value *&leaves) {
   return v;
 }
 
+Value state_part(Value shape, const Value *&leaves) {
+  return state_like(shape, leaves, state_part);
+}
+
 Value state_from_leaves(Value shape, const gcvec<Value> &leaves) {
   const Value *p = leaves.data();
-  return state_like(shape, p);
+  return state_part(shape, p);
 }
 
 // ---- tracing procedures into functions ------------------------------------------------
@@ -1010,20 +1017,6 @@ BuildPlot *arg_plot(Value *a, int i, const char *who) {
   return static_cast<BuildPlot *>(a[i].as<Opaque>()->obj);
 }
 
-// The file name the interpreter gives a plot (builtins_plot.cpp).
-std::string plot_file_name(std::string_view title, int number) {
-  std::string name;
-  for (char c : title) {
-    bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                c == '.' || c == '_' || c == '-';
-    name += keep ? c : '-';
-  }
-  while (!name.empty() && (name[0] == '.' || name[0] == '-'))
-    name.erase(0, 1);
-  if (name.size() > 100) name.resize(100);
-  return name.empty() ? "plot-" + std::to_string(number) : name;
-}
-
 Value P_frame(Value *a, int n) {
   static const char who[] = "frame";
   RStmt s{RKind::Frame};
@@ -1364,18 +1357,7 @@ Value result_like(Value shape, const Value *&leaves) {
     Value a = result_like(car(shape), leaves);
     return cons(a, result_like(cdr(shape), leaves));
   }
-  size_t len;
-  Value *items = container_items(shape, &len);
-  SICM_ASSERT(items); // result_leaves accepted the shape
-  gcvec<Value> parts;
-  for (size_t i = 0; i < len; ++i)
-    parts.push_back(result_like(items[i], leaves));
-  if (is_structure(shape))
-    return make_structure_from(as_structure(shape)->up, parts.data(), parts.size());
-  Value v = make_vector(parts.size(), Value::fixnum(0));
-  for (size_t i = 0; i < parts.size(); ++i)
-    v.vector()->items[i] = parts[i];
-  return v;
+  return state_like(shape, leaves, result_like);
 }
 
 // A parameter of a loop: known (the first call's argument, which every

@@ -39,20 +39,6 @@ double arg_real(Value *a, int i, const char *who) {
   return to_double(a[i]);
 }
 
-// A file name from a title: letters, digits, '.', '_' and '-' are kept.
-std::string file_name_for(std::string_view title) {
-  std::string name;
-  for (char c : title) {
-    bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                c == '.' || c == '_' || c == '-';
-    name += keep ? c : '-';
-  }
-  while (!name.empty() && (name[0] == '.' || name[0] == '-'))
-    name.erase(0, 1);
-  if (name.size() > 100) name.resize(100);
-  return name;
-}
-
 // (frame xmin xmax ymin ymax [title])
 Value P_frame(Value *a, int n) {
   double r[4];
@@ -62,8 +48,7 @@ Value P_frame(Value *a, int n) {
   if (!(r[3] > r[2])) bad_range(a[3], 4, "frame");
   ++g_plot_count;
   std::string title = n > 4 ? std::string(arg_string(a, 4, "frame")) : "";
-  std::string name = title.empty() ? "" : file_name_for(title);
-  if (name.empty()) name = "plot-" + std::to_string(g_plot_count);
+  std::string name = plot_file_name(title, g_plot_count);
   sicm_plot *p = sicm_plot_open(g_plot_dir.c_str(), name.c_str(),
                                 title.empty() ? nullptr : title.c_str(), r[0], r[1], r[2], r[3]);
   if (!p)
@@ -101,6 +86,19 @@ Value P_graphics_clear(Value *a, int) {
 }
 
 } // namespace
+
+std::string plot_file_name(std::string_view title, int number) {
+  std::string name;
+  for (char c : title) {
+    bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                c == '.' || c == '_' || c == '-';
+    name += keep ? c : '-';
+  }
+  while (!name.empty() && (name[0] == '.' || name[0] == '-'))
+    name.erase(0, 1);
+  if (name.size() > 100) name.resize(100);
+  return name.empty() ? "plot-" + std::to_string(number) : name;
+}
 
 void set_plot_directory(const std::string &dir) {
   g_plot_dir = dir;

@@ -2,11 +2,15 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 namespace sicm {
 
 void install_plot_primitives();
 // The directory plot files are written to (default "."; `--plot-dir DIR`).
 void set_plot_directory(const std::string &dir);
+// The file name (without extension) of plot number `number` titled `title`:
+// the title's letters, digits, '.', '_' and '-', or plot-NUMBER without one.
+std::string plot_file_name(std::string_view title, int number);
 
 } // namespace sicm
