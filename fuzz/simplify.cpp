@@ -43,6 +43,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "algebra/expr.hpp"
@@ -191,87 +193,91 @@ bool decode(fuzz::Bytes &in, const Value sym[3], Value *out) {
 }
 
 // A copy of the canonical expression s with the symbols from[i] replaced by
-// to[i], built node by node without any rewriting.
-ExprId rename(ExprId s, const Value from[3], const Value to[3]) {
+// to[i], built node by node without any rewriting (memo: a shared node is
+// copied once, so a DAG costs its size, not the size of its tree).
+ExprId rename(ExprId s, const Value from[3], const Value to[3],
+              std::unordered_map<ExprId, ExprId> &memo) {
+  auto hit = memo.find(s);
+  if (hit != memo.end()) return hit->second;
+  ExprId r = s;
   const ExprNode &n = expr_node(s);
   switch (n.kind) {
   case ExprKind::Rational:
-  case ExprKind::Flonum: return s;
+  case ExprKind::Flonum: break;
   case ExprKind::Symbol:
     for (int i = 0; i < 3; ++i)
-      if (n.sym == from[i].symbol()) return expr_symbol(to[i].symbol());
-    return s;
+      if (n.sym == from[i].symbol()) r = expr_symbol(to[i].symbol());
+    break;
   case ExprKind::Apply: {
     Op op = n.op;
     std::vector<ExprId> args = expr_arg_vector(s);
     for (ExprId &a : args)
-      a = rename(a, from, to);
-    return expr_apply(op, args.data(), args.size());
+      a = rename(a, from, to, memo);
+    r = expr_apply(op, args.data(), args.size());
+    break;
   }
-  case ExprKind::Call: break;
+  case ExprKind::Call:
+    fuzz::fail("a Call node in an expression built from ops.def: " + expr_debug_string(s));
   }
-  fuzz::fail("a Call node in an expression built from ops.def: " + expr_debug_string(s));
+  memo.emplace(s, r);
+  return r;
 }
 
-// Does s hold a flonum anywhere?
+// Does some node of the DAG under root satisfy pred? Each node is visited
+// once (a tree walk of a DAG with shared parts is exponential).
+template <class Pred> bool any_node(ExprId root, Pred pred) {
+  std::vector<ExprId> stack{root};
+  std::unordered_set<ExprId> seen;
+  while (!stack.empty()) {
+    ExprId id = stack.back();
+    stack.pop_back();
+    if (!seen.insert(id).second) continue;
+    if (pred(id)) return true;
+    if (expr_kind(id) == ExprKind::Apply)
+      for (ExprId a : expr_arg_vector(id))
+        stack.push_back(a);
+  }
+  return false;
+}
+
 bool has_flonum(ExprId s) {
-  if (expr_kind(s) == ExprKind::Flonum) return true;
-  if (expr_kind(s) != ExprKind::Apply) return false;
-  for (ExprId a : expr_arg_vector(s))
-    if (has_flonum(a)) return true;
-  return false;
+  return any_node(s, [](ExprId id) { return expr_kind(id) == ExprKind::Flonum; });
 }
 
-// Does s hold a square root inside the argument of another?
-bool has_nested_root(ExprId s, bool inside_root = false) {
-  if (expr_kind(s) != ExprKind::Apply) return false;
-  bool root = expr_is_apply(s, Op::Sqrt);
-  if (root && inside_root) return true;
-  for (ExprId a : expr_arg_vector(s))
-    if (has_nested_root(a, inside_root || root)) return true;
-  return false;
+// A square root inside the argument of another?
+bool has_nested_root(ExprId s) {
+  auto is_root = [](ExprId id) { return expr_is_apply(id, Op::Sqrt); };
+  return any_node(s, [&](ExprId id) { return is_root(id) && any_node(expr_arg(id, 0), is_root); });
 }
 
-// Does s hold a number of magnitude above 1e15 (or beyond the doubles)?
-// Raised to the powers the decoder allows, such a coefficient can overflow.
+// A number of magnitude above 1e15 (or beyond the doubles)? Raised to the
+// powers the decoder allows, such a coefficient can overflow.
 bool has_huge_number(ExprId s) {
-  if (expr_is_number(s)) {
-    double v = to_double(expr_number_value(s));
-    return !(std::fabs(v) <= 1e15);
-  }
-  if (expr_kind(s) != ExprKind::Apply) return false;
-  for (ExprId a : expr_arg_vector(s))
-    if (has_huge_number(a)) return true;
-  return false;
+  return any_node(s, [](ExprId id) {
+    return expr_is_number(id) && !(std::fabs(to_double(expr_number_value(id))) <= 1e15);
+  });
 }
 
-// Does s hold an infinite or NaN flonum?
+// An infinite or NaN flonum?
 bool has_non_finite(ExprId s) {
-  if (expr_kind(s) == ExprKind::Flonum) return !std::isfinite(expr_node(s).d);
-  if (expr_kind(s) != ExprKind::Apply) return false;
-  for (ExprId a : expr_arg_vector(s))
-    if (has_non_finite(a)) return true;
-  return false;
+  return any_node(s, [](ExprId id) {
+    return expr_kind(id) == ExprKind::Flonum && !std::isfinite(expr_node(id).d);
+  });
 }
 
-// Does s hold a quotient with a flonum in it, at any depth?
+// A quotient with a flonum in it, at any depth?
 bool has_flonum_quotient(ExprId s) {
-  if (expr_kind(s) != ExprKind::Apply) return false;
-  if (expr_is_apply(s, Op::Div) && has_flonum(s)) return true;
-  for (ExprId a : expr_arg_vector(s))
-    if (has_flonum_quotient(a)) return true;
-  return false;
+  return any_node(s, [](ExprId id) { return expr_is_apply(id, Op::Div) && has_flonum(id); });
 }
 
-// Does s hold an operator applied to numbers only, like (cos 1)?
+// An operator applied to numbers only, like (cos 1)?
 bool has_numeric_kernel(ExprId s) {
-  if (expr_kind(s) != ExprKind::Apply) return false;
-  bool numbers = true;
-  for (ExprId a : expr_arg_vector(s)) {
-    if (has_numeric_kernel(a)) return true;
-    numbers = numbers && expr_is_number(a);
-  }
-  return numbers;
+  return any_node(s, [](ExprId id) {
+    if (expr_kind(id) != ExprKind::Apply) return false;
+    for (ExprId a : expr_arg_vector(id))
+      if (!expr_is_number(a)) return false;
+    return true;
+  });
 }
 
 std::string show(ExprId id) {
@@ -418,7 +424,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   bool nested_root = has_nested_root(s);
   g_stats.nested_roots += nested_root;
   g_stats.flonum_quotients += flonum_quotient;
-  ExprId r = rename(s, g_sym, g_renamed);
+  std::unordered_map<ExprId, ExprId> renamed;
+  ExprId r = rename(s, g_sym, g_renamed, renamed);
   ExprId rs = flonum_quotient || nested_root ? r : simplify_expr(r);
   if (rs != r)
     fuzz::fail("simplify is not idempotent\n  original:          " + show(e) +
