@@ -265,11 +265,6 @@ bool has_huge_number(ExprId s) {
   });
 }
 
-// A quotient with a flonum in it, at any depth?
-bool has_flonum_quotient(ExprId s) {
-  return any_node(s, [](ExprId id) { return expr_is_apply(id, Op::Div) && has_flonum(id); });
-}
-
 // An operator applied to numbers only, like (cos 1)?
 bool has_numeric_kernel(ExprId s) {
   return any_node(s, [](ExprId id) {
@@ -419,7 +414,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   // (sqrt (/ ...))) is not a fixed point (known bug:
   // fuzz/crashes-found/README.md, simplify-1), so it is left out of this
   // check and the next.
-  bool flonum_quotient = has_flonum_quotient(s);
   // A form with a flonum coefficient of 1., as in (* 1. x), is not one
   // either (simplify-5); so no form with a flonum is checked here.
   bool flonum = has_flonum(s);
