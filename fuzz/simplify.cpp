@@ -200,7 +200,7 @@ ExprId rename(ExprId s, const Value from[3], const Value to[3],
   auto hit = memo.find(s);
   if (hit != memo.end()) return hit->second;
   ExprId r = s;
-  const ExprNode &n = expr_node(s);
+  const ExprNode n = expr_node(s); // a copy: building nodes moves the arena
   switch (n.kind) {
   case ExprKind::Rational:
   case ExprKind::Flonum: break;
