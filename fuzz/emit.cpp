@@ -218,11 +218,24 @@ std::string slurp(const std::string &path) {
 }
 
 // Compile src into a shared object; "" on success, else why not.
+// -Wno-unused-variable: the emitter can leave a temporary unused (known bug:
+// fuzz/crashes-found/README.md, emit-2); remove it with the fix.
 std::string compile(const std::string &c_path, const std::string &so_path) {
   std::string log = c_path + ".log";
-  const char *argv[] = {"cc",           "-std=c11", "-O2",     "-Wall", "-Wextra",
-                        "-Werror",      "-fPIC",    "-shared", "-o",    so_path.c_str(),
-                        c_path.c_str(), "-lm",      nullptr};
+  const char *argv[] = {"cc",
+                        "-std=c11",
+                        "-O2",
+                        "-Wall",
+                        "-Wextra",
+                        "-Werror",
+                        "-Wno-unused-variable",
+                        "-fPIC",
+                        "-shared",
+                        "-o",
+                        so_path.c_str(),
+                        c_path.c_str(),
+                        "-lm",
+                        nullptr};
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, 2, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
@@ -264,8 +277,8 @@ void check_kernel(const Trace &t, uint64_t seed) {
     fuzz::NumEval numeric(inputs, point);
     std::vector<Value> memo;
     std::vector<bool> done;
+    g_stats.outputs += t.outputs.size();
     for (size_t j = 0; j < t.outputs.size(); ++j) {
-      ++g_stats.outputs;
       fuzz::Approx bound = numeric.eval(t.outputs[j]);
       // A value the interpreter cannot give (it raises for sqrt of a
       // negative) or an infinity on the way: not comparable.
