@@ -104,9 +104,12 @@ SANENV := $(if $(SANITIZE),\
   UBSAN_OPTIONS=halt_on_error=1:abort_on_error=1:print_stacktrace=1 \
   SICM_TEST_TIMEOUT_SCALE=10)
 
+# FUZZ=0 leaves out the short fuzz runs (and the clang build they need).
+FUZZ ?= 1
 check: deps
 	@$(MAKE) --no-print-directory all $(UNITBIN)
-	@$(SANENV) python3 tests/run --sicm $(SICM) --unit $(UNITBIN) $(if $(UPDATE),--update)
+	@$(SANENV) python3 tests/run --sicm $(SICM) --unit $(UNITBIN) $(if $(UPDATE),--update) \
+	  $(if $(filter 1,$(FUZZ)),--fuzz scripts/fuzz)
 
 demo: deps
 	@$(MAKE) --no-print-directory all

@@ -1,6 +1,7 @@
 // Printing values as MIT Scheme writes and displays them.
 #include "print/printer.hpp"
 
+#include "syntax/reader.hpp"
 #include "syntax/utf8.hpp"
 
 #include <unordered_map>
@@ -106,11 +107,18 @@ void print_value(std::string &out, Value v, bool display) {
   case Tag::Bignum:
   case Tag::Ratnum: out += number_to_string(v); return;
   case Tag::Symbol: {
+    // Uninterned symbols print by name too, as MIT does.
     const std::string &name = symbol_name(v);
-    if (display || !v.symbol()->uninterned)
+    if (display || !symbol_needs_bars(name)) {
       out += name;
-    else
-      out += name; // uninterned symbols print by name, as MIT does
+      return;
+    }
+    out += '|';
+    for (char c : name) {
+      if (c == '|' || c == '\\') out += '\\';
+      out += c;
+    }
+    out += '|';
     return;
   }
   case Tag::String:

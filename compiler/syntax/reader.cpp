@@ -368,6 +368,19 @@ Value Reader::read_atom(SrcLoc start) {
   return intern(token);
 }
 
+bool symbol_needs_bars(std::string_view name) {
+  if (name.empty() || name == "." || name[0] == '#') return true;
+  for (char ch : name) {
+    int c = static_cast<unsigned char>(ch);
+    if (is_delimiter(c) || c == '|' || c == '[' || c == ']') return true;
+  }
+  // What read_atom would take for a number (or refuse as n/0).
+  if (parse_number(name)) return true;
+  size_t slash = name.find('/');
+  return slash != std::string_view::npos && slash + 2 == name.size() && name.back() == '0' &&
+         parse_number(name.substr(0, slash));
+}
+
 gcvec<ReadForm> read_all(uint32_t file) {
   Reader reader(file);
   gcvec<ReadForm> forms;

@@ -57,6 +57,11 @@ private:
 // Read every datum of a registered source. Throws on the first error.
 gcvec<ReadForm> read_all(uint32_t file);
 
+// Whether a symbol of this name must be written in bars (|a b|) to read back
+// as itself: it is empty, holds a delimiter, a bar or a bracket, starts with
+// #, or reads as a number or as the dot of a dotted list.
+bool symbol_needs_bars(std::string_view name);
+
 // Nesting deeper than this is a clear error rather than a stack overflow.
 constexpr int kMaxReadDepth = 10000;
 
