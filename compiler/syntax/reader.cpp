@@ -369,6 +369,8 @@ Value Reader::read_atom(SrcLoc start) {
 }
 
 bool symbol_needs_bars(std::string_view name) {
+  // read_hash makes these two symbols of #!optional and #!rest.
+  if (name == "#!optional" || name == "#!rest") return false;
   if (name.empty() || name == "." || name[0] == '#') return true;
   for (char ch : name) {
     int c = static_cast<unsigned char>(ch);
