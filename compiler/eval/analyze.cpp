@@ -259,6 +259,14 @@ Value case_expand(Value x, SrcLoc loc) {
   return list({sym("let"), list({list({tmp, key})}), cond});
 }
 
+// The forms of `forms` followed by `last`, in new pairs that keep the source
+// places of the old ones: an error in one of the user's forms then points at
+// that form, not at the whole rewritten construct.
+Value append_keeping_places(Value forms, Value last) {
+  if (!is_pair(forms)) return list({last});
+  return cons(car(forms), append_keeping_places(cdr(forms), last), forms.pair()->loc);
+}
+
 // (do ((var init step)...) (test res...) command...) -> a named let loop.
 Value do_expand(Value x, SrcLoc loc) {
   if (list_length(x) < 3) ill_formed(x, loc);
@@ -268,20 +276,23 @@ Value do_expand(Value x, SrcLoc loc) {
   if (list_length(specs) < 0 || list_length(exit) < 1) ill_formed(x, loc);
   Value loop = make_uninterned_symbol("do-loop");
   gcvec<Value> bindings, steps;
+  std::vector<SrcLoc> step_places;
   for (Value s = specs; !is_null(s); s = cdr(s)) {
     Value spec = car(s);
     long n = list_length(spec);
     if (n < 2 || n > 3 || !is_symbol(car(spec))) ill_formed(x, loc);
-    bindings.push_back(list({car(spec), car(cdr(spec))}));
+    bindings.push_back(cons(car(spec), cons(car(cdr(spec)), Value::nil(), cdr(spec).pair()->loc)));
     steps.push_back(n == 3 ? car(cdr(cdr(spec))) : car(spec));
+    step_places.push_back(n == 3 ? cdr(cdr(spec)).pair()->loc : spec.pair()->loc);
   }
   Value result = is_null(cdr(exit)) ? Value::unspecified() : cons(sym("begin"), cdr(exit));
-  Value again = cons(loop, list_from(steps.data(), steps.size()));
-  gcvec<Value> cmds = list_to_vector(commands);
-  cmds.push_back(again);
-  Value body = cons(sym("begin"), list_from(cmds.data(), cmds.size()));
+  Value step_list = Value::nil();
+  for (size_t i = steps.size(); i-- > 0;)
+    step_list = cons(steps[i], step_list, step_places[i]);
+  Value again = cons(loop, step_list);
+  Value body = cons(sym("begin"), append_keeping_places(commands, again));
   return list({sym("let"), loop, list_from(bindings.data(), bindings.size()),
-               list({sym("if"), car(exit), result, body})});
+               cons(sym("if"), cons(car(exit), list({result, body}), exit.pair()->loc))});
 }
 
 // (let* ((a 1) (b a)) body) -> nested lets.
