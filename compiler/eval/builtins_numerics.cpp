@@ -455,6 +455,11 @@ const IntegratorName kIntegrators[] = {
     {"qcctrap2", &sicm_ode_step_msbdf, "sicm_ode_step_msbdf"},
     {"cvode-adams", &sicm_ode_step_cvode_adams, "sicm_ode_step_cvode_adams"},
     {"cvode-bdf", &sicm_ode_step_cvode_bdf, "sicm_ode_step_cvode_bdf"},
+    // Fixed-step symplectic methods: the tolerance argument is the step size.
+    {"verlet", &sicm_ode_step_verlet, "sicm_ode_step_verlet"},
+    {"yoshida4", &sicm_ode_step_yoshida4, "sicm_ode_step_yoshida4"},
+    {"yoshida6", &sicm_ode_step_yoshida6, "sicm_ode_step_yoshida6"},
+    {"yoshida8", &sicm_ode_step_yoshida8, "sicm_ode_step_yoshida8"},
 };
 
 const IntegratorName *find_integrator(const std::string &name) {
@@ -478,7 +483,7 @@ const sicm_ode_step_type *arg_integrator(Value *a, int n, int i, const char *who
       runtime_error(current_call_loc(),
                     std::string(who) + ": *ode-integration-method* is " + write_string(m) +
                         ", which names no integrator (bulirsch-stoer, rk8pd, rkf45, rkck, msbdf, "
-                        "cvode-adams, cvode-bdf)");
+                        "cvode-adams, cvode-bdf, verlet, yoshida4, yoshida6, yoshida8)");
     return T;
   }
   const sicm_ode_step_type *T = is_symbol(a[i]) ? integrator_for(symbol_name(a[i])) : nullptr;

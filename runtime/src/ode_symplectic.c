@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ode_internal.h"
 #include "sicm/runtime.h"
 
 enum { kMaxStages = 15, kMaxStateShown = 8 };
@@ -143,6 +144,20 @@ static int step(const double *w, int stages, size_t ndof, sicm_force dVdq, sicm_
   return SICM_SUCCESS;
 }
 
+/* How a run of steps ended, for the caller to report in its own terms. */
+typedef struct {
+  const char *what, *detail; /* set when the run failed */
+  unsigned long long steps;  /* steps completed */
+} run_outcome;
+
+/* Advance (q, p) from *t to t1 in equal steps of at most |h|, as
+ * sicm_symplectic_evolve documents, without reporting a failure: on one, q,
+ * p and *t are the last proper state and out says what went wrong. The
+ * arguments have been checked. */
+static int run_steps(const sicm_symplectic_type *T, size_t ndof, sicm_force dVdq,
+                     sicm_velocity dTdp, void *params, double *t, double t1, double h, double *q,
+                     double *p, run_outcome *out);
+
 int sicm_symplectic_evolve(const sicm_symplectic_type *T, size_t ndof, sicm_force dVdq,
                            sicm_velocity dTdp, void *params, double *t, double t1, double h,
                            double *q, double *p) {
@@ -158,16 +173,28 @@ int sicm_symplectic_evolve(const sicm_symplectic_type *T, size_t ndof, sicm_forc
     return fail(T, SICM_EINVAL, ndof, *t, q, p, "non-finite state",
                 "the initial state has NaN or infinite components");
   if (*t == t1) return SICM_SUCCESS;
+  run_outcome out = {0};
+  int status = run_steps(T, ndof, dVdq, dTdp, params, t, t1, h, q, p, &out);
+  if (status == SICM_ENOMEM)
+    return sicm_error(status, "sicm_symplectic_evolve (%s): %s", T->name, out.detail);
+  if (status != SICM_SUCCESS) return fail(T, status, ndof, *t, q, p, out.what, out.detail);
+  return SICM_SUCCESS;
+}
 
+static int run_steps(const sicm_symplectic_type *T, size_t ndof, sicm_force dVdq,
+                     sicm_velocity dTdp, void *params, double *t, double t1, double h, double *q,
+                     double *p, run_outcome *out) {
   const double t0 = *t, span = t1 - t0;
   /* The smallest step count with |dt| <= |h|, forgiving rounding in span/h
    * so that h dividing the interval gives exactly span/h steps. */
   double ratio = fabs(span / h), whole = round(ratio);
   double count = fabs(ratio - whole) <= 1e-9 * ratio ? whole : ceil(ratio);
   if (count < 1) count = 1;
-  if (count > 1e15)
-    return sicm_error(SICM_EINVAL, "sicm_symplectic_evolve (%s): %g steps of %g are too many",
-                      T->name, count, h);
+  if (count > 1e15) {
+    out->what = "too many steps";
+    out->detail = "the interval needs more than 1e15 steps of the given size";
+    return SICM_EINVAL;
+  }
   const unsigned long long nsteps = (unsigned long long)count;
   const double dt = span / count;
 
@@ -177,8 +204,10 @@ int sicm_symplectic_evolve(const sicm_symplectic_type *T, size_t ndof, sicm_forc
    * last proper state known, which the caller gets back if a step fails.
    * start_q: q at the start of the current step. */
   double *scratch = malloc(5 * ndof * sizeof *scratch);
-  if (!scratch)
-    return sicm_error(SICM_ENOMEM, "sicm_symplectic_evolve (%s): out of memory", T->name);
+  if (!scratch) {
+    out->what = out->detail = "out of memory";
+    return SICM_ENOMEM;
+  }
   double *force = scratch, *velocity = force + ndof, *good_q = velocity + ndof;
   double *good_p = good_q + ndof, *start_q = good_p + ndof;
   memcpy(good_q, q, ndof * sizeof *q);
@@ -197,6 +226,7 @@ int sicm_symplectic_evolve(const sicm_symplectic_type *T, size_t ndof, sicm_forc
     }
     if (status == SICM_SUCCESS && !(all_finite(ndof, q) && all_finite(ndof, p)))
       status = SICM_EBADFUNC;
+    if (status == SICM_SUCCESS) out->steps++;
   }
   if (status == SICM_SUCCESS) { /* pay the last half kick at t1 */
     if (dVdq(t1, q, force, params) == 0) {
@@ -211,12 +241,184 @@ int sicm_symplectic_evolve(const sicm_symplectic_type *T, size_t ndof, sicm_forc
     memcpy(q, good_q, ndof * sizeof *q);
     memcpy(p, good_p, ndof * sizeof *p);
     *t = good_t;
-    status = status == SICM_EUSER
-                 ? fail(T, status, ndof, good_t, q, p, "stopped by the system",
-                        "a force or velocity function returned non-zero")
-                 : fail(T, status, ndof, good_t, q, p, "non-finite state",
-                        "a step produced NaN or infinity (is the step too long for the force?)");
+    if (status == SICM_EUSER) {
+      out->what = "stopped by the system";
+      out->detail = "a force or velocity function returned non-zero";
+    } else {
+      out->what = "non-finite state";
+      out->detail = "a step produced NaN or infinity (is the step too long for the force?)";
+    }
   }
   free(scratch);
   return status;
 }
+
+/* ---- the same methods as sicm_ode step types ------------------------------
+ * So that evolve and state-advancer can use them like any integrator, each
+ * method is also a sicm_ode_step_type working on the book's states
+ * y = (t, q_1..q_n, p_1..p_n) through the ordinary right-hand side: the
+ * velocity dT/dp is the q part of f(t, y) and the force -dV/dq its p part.
+ * That is right only for a separable system, where the q part of f does not
+ * depend on t or q and the p part not on p; the first evolve checks this at
+ * the starting point (bitwise: a separable system computes the same numbers
+ * whatever the other half holds) and refuses a system that fails it. A
+ * Lagrangian state (t, q, qdot) with a constant mass matrix passes too; for
+ * it the map is symplectic in (q, M qdot). The step size is the abs_tol
+ * given to sicm_ode_alloc. */
+
+typedef struct {
+  const sicm_symplectic_type *method;
+  sicm_ode *o;
+  double *work; /* the state the right-hand side is called at */
+  double *dydt;
+  size_t ndof;
+  int call_status; /* what the last right-hand side call returned */
+  int checked;     /* separability verified */
+} fixed_step;
+
+static fixed_step *fixed_of(sicm_ode *o) {
+  return (fixed_step *)o->backend;
+}
+
+static int fixed_init(sicm_ode *o) {
+  fixed_step *b = calloc(1, sizeof *b);
+  if (!b) return SICM_ENOMEM;
+  b->method = (const sicm_symplectic_type *)o->type->data;
+  b->o = o;
+  b->work = malloc(2 * o->dim * sizeof *b->work);
+  if (!b->work) {
+    free(b);
+    return SICM_ENOMEM;
+  }
+  b->dydt = b->work + o->dim;
+  b->ndof = (o->dim - 1) / 2;
+  o->backend = b;
+  return SICM_SUCCESS;
+}
+
+static void fixed_reset(sicm_ode *o) {
+  (void)o; /* fixed steps keep nothing between calls */
+}
+
+static void fixed_free(sicm_ode *o) {
+  fixed_step *b = fixed_of(o);
+  free(b->work);
+  free(b);
+  o->backend = NULL;
+}
+
+/* -dV/dq at (t, q) is the p part of f; work keeps the last p, which a
+ * separable system does not read. */
+static int fixed_force(double t, const double *q, double *dVdq, void *params) {
+  fixed_step *b = params;
+  b->work[0] = t;
+  memcpy(b->work + 1, q, b->ndof * sizeof *q);
+  b->call_status = sicm_ode_call_rhs(b->o, t, b->work, b->dydt);
+  if (b->call_status != SICM_SUCCESS) return 1;
+  for (size_t i = 0; i < b->ndof; i++)
+    dVdq[i] = -b->dydt[1 + b->ndof + i];
+  return 0;
+}
+
+/* dT/dp at p is the q part of f, whatever t and q work holds. */
+static int fixed_velocity(const double *p, double *dTdp, void *params) {
+  fixed_step *b = params;
+  memcpy(b->work + 1 + b->ndof, p, b->ndof * sizeof *p);
+  b->call_status = sicm_ode_call_rhs(b->o, b->work[0], b->work, b->dydt);
+  if (b->call_status != SICM_SUCCESS) return 1;
+  memcpy(dTdp, b->dydt + 1, b->ndof * sizeof *dTdp);
+  return 0;
+}
+
+/* A point near y whose half [from, from + n) is moved by about a tenth of
+ * its size (and the time too when move_time). */
+static void displaced(const double *y, size_t dim, size_t from, size_t n, int move_time,
+                      double *out) {
+  memcpy(out, y, dim * sizeof *y);
+  if (move_time) out[0] += 0.1 * (1.0 + fabs(y[0]));
+  for (size_t i = from; i < from + n; i++)
+    out[i] += 0.1 * (1.0 + fabs(y[i]));
+}
+
+/* Is the system separable at (t, y)? Returns SICM_SUCCESS or a failure
+ * already reported. */
+static int check_separable(sicm_ode *o, double t, const double *y) {
+  fixed_step *b = fixed_of(o);
+  const size_t n = b->ndof, dim = o->dim;
+  double *f0 = malloc(2 * dim * sizeof *f0);
+  if (!f0) return sicm_ode_fail(o, SICM_ENOMEM, t, y, "out of memory", NULL);
+  double *moved = f0 + dim;
+  const char *why = NULL;
+  int s = sicm_ode_call_rhs(o, t, y, f0);
+  if (s == SICM_SUCCESS && f0[0] != 1.0)
+    why = "the state's first component must be the time, whose rate is 1";
+  if (s == SICM_SUCCESS && !why) { /* dq/dt must not depend on t or q */
+    displaced(y, dim, 1, n, 1, moved);
+    s = sicm_ode_call_rhs(o, moved[0], moved, b->dydt);
+    if (s == SICM_SUCCESS && memcmp(f0 + 1, b->dydt + 1, n * sizeof *f0) != 0)
+      why = "dq/dt changes with q or t, so the Hamiltonian is not T(p) + V(t, q)";
+  }
+  if (s == SICM_SUCCESS && !why) { /* dp/dt must not depend on p */
+    displaced(y, dim, 1 + n, n, 0, moved);
+    s = sicm_ode_call_rhs(o, t, moved, b->dydt);
+    if (s == SICM_SUCCESS && memcmp(f0 + 1 + n, b->dydt + 1 + n, n * sizeof *f0) != 0)
+      why = "dp/dt changes with p, so the Hamiltonian is not T(p) + V(t, q)";
+  }
+  free(f0);
+  if (s == SICM_EUSER) return sicm_ode_fail_user(o, t, y);
+  if (s != SICM_SUCCESS)
+    return sicm_ode_fail(o, s, t, y, "non-finite derivative",
+                         "the system derivative is NaN or infinite at the starting point");
+  if (why) return sicm_ode_fail(o, SICM_EINVAL, t, y, "the system is not separable", why);
+  return SICM_SUCCESS;
+}
+
+static int fixed_evolve(sicm_ode *o, double *t, double t1, double *y) {
+  fixed_step *b = fixed_of(o);
+  if (o->dim < 3 || o->dim % 2 == 0)
+    return sicm_ode_fail(o, SICM_EINVAL, *t, y, "unsuitable state",
+                         "a symplectic method needs a state (t, q, p) with as many momenta "
+                         "or velocities as coordinates");
+  if (!b->checked) {
+    int s = check_separable(o, *t, y);
+    if (s != SICM_SUCCESS) return s;
+    b->checked = 1;
+  }
+  const double h = o->abs_tol;
+  const double steps = ceil(fabs(t1 - *t) / h);
+  if (steps > (double)o->max_steps) {
+    char detail[200];
+    snprintf(detail, sizeof detail,
+             "%.0f steps of %g are needed and the limit is %lu (for %s the tolerance argument "
+             "is the step size)",
+             steps, h, o->max_steps, b->method->name);
+    return sicm_ode_fail(o, SICM_EMAXITER, *t, y, "too many steps", detail);
+  }
+  memcpy(b->work, y, o->dim * sizeof *y);
+  b->work[0] = *t;
+  run_outcome out = {0};
+  double *q = y + 1, *p = y + 1 + b->ndof;
+  int s = run_steps(b->method, b->ndof, fixed_force, fixed_velocity, b, t, t1, h, q, p, &out);
+  o->stats.steps += (unsigned long)out.steps;
+  y[0] = *t;
+  if (s == SICM_SUCCESS) return SICM_SUCCESS;
+  if (s == SICM_EUSER && b->call_status == SICM_EUSER) return sicm_ode_fail_user(o, *t, y);
+  if (s == SICM_EUSER) /* the right-hand side was NaN or infinite */
+    return sicm_ode_fail(o, SICM_EBADFUNC, *t, y, "non-finite derivative",
+                         "the system derivative became NaN or infinite (is the step too long?)");
+  return sicm_ode_fail(o, s, *t, y, out.what, out.detail);
+}
+
+static const sicm_ode_step_type verlet_type = {"verlet",    fixed_init, fixed_evolve,
+                                               fixed_reset, fixed_free, &verlet};
+static const sicm_ode_step_type yoshida4_type = {"yoshida4",  fixed_init, fixed_evolve,
+                                                 fixed_reset, fixed_free, &yoshida4};
+static const sicm_ode_step_type yoshida6_type = {"yoshida6",  fixed_init, fixed_evolve,
+                                                 fixed_reset, fixed_free, &yoshida6};
+static const sicm_ode_step_type yoshida8_type = {"yoshida8",  fixed_init, fixed_evolve,
+                                                 fixed_reset, fixed_free, &yoshida8};
+
+const sicm_ode_step_type *const sicm_ode_step_verlet = &verlet_type;
+const sicm_ode_step_type *const sicm_ode_step_yoshida4 = &yoshida4_type;
+const sicm_ode_step_type *const sicm_ode_step_yoshida6 = &yoshida6_type;
+const sicm_ode_step_type *const sicm_ode_step_yoshida8 = &yoshida8_type;

@@ -44,7 +44,21 @@ typedef int (*sicm_ode_jacobian)(double t, const double *y, double *dfdy, double
  *                              with fixed-point iteration; non-stiff.
  *   sicm_ode_step_cvode_bdf    SUNDIALS CVODE, variable-order (1-5) BDF with Newton
  *                              iteration and a dense linear solver; stiff. Uses the
- *                              Jacobian if set, difference quotients otherwise. */
+ *                              Jacobian if set, difference quotients otherwise.
+ *   sicm_ode_step_verlet       The symplectic methods below (Stormer-Verlet and
+ *   sicm_ode_step_yoshida4     Yoshida's compositions of orders 4, 6, 8) as step
+ *   sicm_ode_step_yoshida6     types, for separable systems in the book's states
+ *   sicm_ode_step_yoshida8     y = (t, q_1..q_n, p_1..p_n) (or velocities instead
+ *                              of momenta, with a constant mass matrix). Fixed
+ *                              step: abs_tol given to sicm_ode_alloc is the step
+ *                              size, not a tolerance; each evolve covers its
+ *                              interval in equal steps of at most that size.
+ *                              The velocity is the q part of the right-hand side
+ *                              and the force its p part, so the first evolve
+ *                              checks, at its starting point, that the q part
+ *                              does not depend on t or q nor the p part on p,
+ *                              and fails with SICM_EINVAL ("the system is not
+ *                              separable") otherwise. */
 typedef struct sicm_ode_step_type sicm_ode_step_type;
 
 extern const sicm_ode_step_type *const sicm_ode_step_rk8pd;
@@ -54,6 +68,10 @@ extern const sicm_ode_step_type *const sicm_ode_step_msbdf;
 extern const sicm_ode_step_type *const sicm_ode_step_bs;
 extern const sicm_ode_step_type *const sicm_ode_step_cvode_adams;
 extern const sicm_ode_step_type *const sicm_ode_step_cvode_bdf;
+extern const sicm_ode_step_type *const sicm_ode_step_verlet;
+extern const sicm_ode_step_type *const sicm_ode_step_yoshida4;
+extern const sicm_ode_step_type *const sicm_ode_step_yoshida6;
+extern const sicm_ode_step_type *const sicm_ode_step_yoshida8;
 
 /* sicm_ode_step_type_name returns the type's short name ("rk8pd", "bs",
  * "cvode-bdf", ...), as used in messages. */
