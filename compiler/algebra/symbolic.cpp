@@ -10,6 +10,7 @@
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
 #include "print/printer.hpp"
+#include "sicm/runtime.h"
 
 namespace sicm {
 
@@ -59,6 +60,53 @@ ExprId value_to_expr(Value v, int argpos, const char *who) {
     if (is_number(v)) return expr_from_number(v);
     wrong_type(v, argpos, who);
   }
+}
+
+// ---- decimal constants (see DecimalConstants) -------------------------------------
+
+thread_local int g_decimal_constants = 0;
+
+// The exact rational of the shortest decimal that reads back as the flonum d
+// (finite): digits d1...dn and exponent e denote d1.d2...dn * 10^e.
+Value decimal_rational(double d) {
+  if (d == 0) return Value::fixnum(0);
+  char digits[32];
+  int e10 = 0;
+  size_t n = sicm_shortest_digits(digits, &e10, d);
+  digits[n] = '\0';
+  mpq_t q;
+  mpq_init(q);
+  mpz_set_str(mpq_numref(q), digits, 10);
+  int scale = e10 - static_cast<int>(n - 1); // value = digits * 10^scale
+  mpz_t p;
+  mpz_init(p);
+  mpz_ui_pow_ui(p, 10, static_cast<unsigned long>(scale < 0 ? -scale : scale));
+  if (scale < 0)
+    mpz_set(mpq_denref(q), p);
+  else
+    mpz_mul(mpq_numref(q), mpq_numref(q), p);
+  mpz_clear(p);
+  if (d < 0) mpz_neg(mpq_numref(q), mpq_numref(q));
+  Value v = make_rational(q);
+  mpq_clear(q);
+  return v;
+}
+
+// The arguments of an operation, with finite flonums made decimal rationals
+// when the mode is on and some argument is symbolic. Returns args itself
+// when nothing changes.
+const Value *decimal_arguments(const Value *args, int nargs, gcvec<Value> &storage) {
+  if (g_decimal_constants == 0) return args;
+  bool symbolic = false, flonum = false;
+  for (int i = 0; i < nargs; i++) {
+    symbolic = symbolic || !is_number(args[i]);
+    flonum = flonum || (args[i].is(Tag::Flonum) && std::isfinite(args[i].d));
+  }
+  if (!symbolic || !flonum) return args;
+  storage.assign(args, args + nargs);
+  for (Value &v : storage)
+    if (v.is(Tag::Flonum) && std::isfinite(v.d)) v = decimal_rational(v.d);
+  return storage.data();
 }
 
 // ---- construction with light rewrites ----------------------------------------------
@@ -146,7 +194,17 @@ const OpInfo &op_info(Op op) {
   return kOpInfo[static_cast<size_t>(op)];
 }
 
-Value symbolic_apply(Op op, const Value *args, int nargs) {
+DecimalConstants::DecimalConstants() {
+  ++g_decimal_constants;
+}
+
+DecimalConstants::~DecimalConstants() {
+  --g_decimal_constants;
+}
+
+Value symbolic_apply(Op op, const Value *raw_args, int nargs) {
+  gcvec<Value> decimal;
+  const Value *args = decimal_arguments(raw_args, nargs, decimal);
   const char *who = op_info(op).scheme_name;
   int arity = op_info(op).arity;
   bool n_ary = op == Op::Add || op == Op::Mul || op == Op::Sub || op == Op::Div;

@@ -57,6 +57,25 @@ Value simplify_value(Value v);
 // are returned as they are.
 Value expression_to_datum(Value v);
 
+// While a DecimalConstants object lives (on this thread), a finite flonum
+// that meets a symbolic value in arithmetic enters the expression as the
+// exact rational of its shortest decimal form: 9.8 as 49/5, 1.5 as 3/2, not
+// as the binary fractions the doubles hold. Tracing a procedure into a
+// kernel uses it: a parameter written 9.8 means 49/5, and with exact
+// constants the simplifier cancels what cancels on paper (flonums rounded
+// before the algebra leave terms of relative size 1e-16 that never cancel,
+// and coefficients of size 1e46 from clearing binary denominators). The
+// kernel's numbers are rounded to doubles once, at emission, so a constant
+// the user wrote reads back as exactly the double it was. Arithmetic on
+// numbers alone is untouched: (* 1.5 9.8) is still a flonum product.
+class DecimalConstants {
+public:
+  DecimalConstants();
+  ~DecimalConstants();
+  DecimalConstants(const DecimalConstants &) = delete;
+  DecimalConstants &operator=(const DecimalConstants &) = delete;
+};
+
 // Register the algebra's primitives (simplify, print-expression, pe,
 // expression, datum->expression) and the printer's converter that shows an
 // expression as its simplified prefix form. Called by init_interpreter.

@@ -17,6 +17,7 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "codegen/emit_c.hpp"
+#include "codegen/evaluation_form.hpp"
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/number.hpp"
@@ -109,6 +110,7 @@ bool collect_outputs(Value result, Trace *t, std::string *why_not) {
       if (!check_expression(id, inputs, seen, why_not)) return false;
       t->outputs.push_back(id);
     }
+    to_evaluation_form(t->outputs);
     return true;
   }
   ExprId id = leaf_expr(simplify_value(result));
@@ -121,6 +123,7 @@ bool collect_outputs(Value result, Trace *t, std::string *why_not) {
   if (!check_expression(id, inputs, seen, why_not)) return false;
   t->result_shape = Value::fixnum(0);
   t->outputs.push_back(id);
+  to_evaluation_form(t->outputs);
   return true;
 }
 
@@ -164,6 +167,7 @@ bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_n
                        : symbols[first]);
   }
   try {
+    DecimalConstants decimal; // 9.8 means 49/5 in the kernel's algebra
     Value result = apply_procedure(proc, args.data(), static_cast<int>(args.size()));
     return collect_outputs(result, t, why_not);
   } catch (const Error &e) {

@@ -33,6 +33,7 @@
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
+#include "codegen/evaluation_form.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
 #include "eval/limits.hpp"
@@ -869,6 +870,7 @@ bool derivative_leaves(Value d, Value shape, gcvec<Value> &out) {
 void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
   if (!is_state_shape(state)) wrong_type(state, 1, who);
   FunctionScope scope(procedure_name(sysder));
+  DecimalConstants decimal; // as sicm run traces its kernels
   Value x = input_like(state);
   Value d = apply_procedure(sysder, &x, 1);
   gcvec<Value> leaves;
@@ -876,8 +878,11 @@ void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
     cannot_compile(here(), std::string("the system derivative passed to ") + who + " returns " +
                                describe(d) + ", which is not shaped like the state " +
                                describe(state));
+  std::vector<ExprId> outputs;
   for (Value leaf : leaves)
-    current().outputs.push_back(expr_of(simplify_value(leaf), who));
+    outputs.push_back(expr_of(simplify_value(leaf), who));
+  to_evaluation_form(outputs); // as sicm run's kernels are emitted
+  current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
   s.callee = scope.id();
   size_t len;
   Value *items = container_items(state, &len);
@@ -897,6 +902,7 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
   size_t nfunctions = g_prog->functions.size(), nvars = g_prog->vars.size();
   try {
     FunctionScope scope("jacobian");
+    DecimalConstants decimal;
     Value x = input_like(state);
     Value dsys = apply_procedure(d->global, &sysder, 1);
     Value j = apply_procedure(dsys, &x, 1);
@@ -904,8 +910,11 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
     state_leaves(j, leaves);
     size_t n = current().inputs.size();
     if (leaves.size() != n * n) return;
+    std::vector<ExprId> outputs;
     for (Value leaf : leaves)
-      current().outputs.push_back(expr_of(simplify_value(leaf), "jacobian"));
+      outputs.push_back(expr_of(simplify_value(leaf), "jacobian"));
+    to_evaluation_form(outputs);
+    current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
     s.jacobian = scope.id();
   } catch (const Error &) {
     for (size_t v = nvars; v < g_prog->vars.size(); ++v)

@@ -12,6 +12,7 @@
 #include "algebra/simplify.hpp"
 #include "algebra/symbolic.hpp"
 #include "eval/number.hpp"
+#include "expr_evaluate.hpp"
 #include "print/printer.hpp"
 #include "syntax/error.hpp"
 #include "syntax/reader.hpp"
@@ -269,8 +270,6 @@ TEST(Simplify, MixedPartialsCommute) {
   EXPECT_EQ(pe(a), "(((partial 0) ((partial 1) H)) (up t x))");
 }
 
-double evaluate_node(ExprId id, double x, double y, double *largest);
-
 // Random expressions: the simplified form has the same value at random
 // points, is canonical, and simplifies to itself.
 class RandomExpressions {
@@ -314,47 +313,10 @@ private:
 };
 
 // The value of an expression of x and y; *largest grows to the largest
-// magnitude met on the way (large arguments of exp and sin make values that
-// differently arranged computations cannot reproduce).
+// magnitude met on the way.
 double evaluate(ExprId id, double x, double y, double *largest) {
-  double v = evaluate_node(id, x, y, largest);
-  *largest = std::max(*largest, std::fabs(v));
-  return v;
-}
-
-double evaluate_node(ExprId id, double x, double y, double *largest) {
-  const ExprNode &n = expr_node(id);
-  switch (n.kind) {
-  case ExprKind::Rational:
-  case ExprKind::Flonum: return to_double(expr_number_value(id));
-  case ExprKind::Symbol: return n.sym->name == "x" ? x : y;
-  case ExprKind::Call: return NAN;
-  case ExprKind::Apply: break;
-  }
-  Op op = n.op;
-  std::vector<double> v;
-  for (ExprId a : expr_arg_vector(id))
-    v.push_back(evaluate(a, x, y, largest));
-  double r = 0;
-  switch (op) {
-  case Op::Add:
-    for (double d : v)
-      r += d;
-    return r;
-  case Op::Mul:
-    r = 1;
-    for (double d : v)
-      r *= d;
-    return r;
-  case Op::Div: return v[0] / v[1];
-  case Op::Expt: return std::pow(v[0], v[1]);
-  case Op::Sqrt: return std::sqrt(v[0]);
-  case Op::Exp: return std::exp(v[0]);
-  case Op::Log: return std::log(v[0]);
-  case Op::Sin: return std::sin(v[0]);
-  case Op::Cos: return std::cos(v[0]);
-  default: return NAN;
-  }
+  return expr_evaluate(
+      id, [&](const std::string &name) { return name == "x" ? x : y; }, largest);
 }
 
 // SICM_FUZZ_SEED and SICM_FUZZ_COUNT run other and more cases, for a longer
