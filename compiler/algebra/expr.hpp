@@ -37,8 +37,10 @@
 //   I4  an Apply has the arity its operator allows: exactly `arity` arguments
 //       for fixed-arity operators, 1 or 2 for atan, at least 2 for + and *,
 //       exactly 2 for / ; there are no Apply nodes of - (generic subtraction
-//       builds (+ a (* -1 b))), and / is made only by the simplifier, as the
-//       top of a quotient of two polynomials.
+//       builds (+ a (* -1 b))). Generic division builds (/ a b) (a quotient
+//       rounds differently from a product with a reciprocal, and compiled
+//       code must round as the interpreter does); in canonical form / is only
+//       the top of a quotient of two polynomials (C6).
 //
 // CANONICAL FORM (what simplify returns; checked by expr_is_canonical, which
 // the simplifier asserts on its results in builds without NDEBUG):

@@ -169,6 +169,20 @@ Value reciprocal(Value v) {
   return build_power(v, Value::fixnum(-1));
 }
 
+// a / b as a quotient node, not as a product with the reciprocal of b:
+// x / 3. and x * (1/3.) round differently, and the residual C of sicm build
+// must divide where the interpreter divides (the simplifier reads both forms
+// as the same rational function). Division by an exact zero is MIT's error,
+// by an exact one is a; an exact zero divided by anything is 0.
+Value build_quotient(Value a, Value b) {
+  if (exact_zero(b)) return reciprocal(b); // raises
+  if (exact_one(b)) return a;
+  if (exact_zero(a)) return a;
+  ExprId n = value_to_expr(a, 1, "/");
+  ExprId d = value_to_expr(b, 2, "/");
+  return expr_value(expr_apply(Op::Div, {n, d}));
+}
+
 Value fold_unary(Op op, Value x) {
   switch (op) {
   case Op::Sqrt: return num_sqrt(x);
@@ -226,11 +240,11 @@ Value symbolic_apply(Op op, const Value *raw_args, int nargs) {
     return build_sum(terms.data(), static_cast<int>(terms.size()), who);
   }
   case Op::Div: {
-    if (nargs == 1) return reciprocal(args[0]);
-    gcvec<Value> factors{args[0]};
+    if (nargs == 1) return build_quotient(Value::fixnum(1), args[0]);
+    Value q = args[0];
     for (int i = 1; i < nargs; i++)
-      factors.push_back(reciprocal(args[i]));
-    return build_product(factors.data(), static_cast<int>(factors.size()), who);
+      q = build_quotient(q, args[i]);
+    return q;
   }
   case Op::Expt:
     if (is_number(args[0]) && is_number(args[1])) return num_expt(args[0], args[1]);
