@@ -1308,7 +1308,9 @@ Value hook_logic(Value test, Node *n, uint32_t from, bool is_and, Frame *env) {
 }
 
 Value push_onto_list(Value *place, const std::string &name, Value element, SrcLoc loc,
-                     bool may_create, Frame *frame);
+                     bool may_create, Frame *frame, bool in_loop);
+
+bool grows_in_loop(Frame *frame);
 
 // An assignment of v to *place (a global's value or a local variable's
 // slot) named `name`. `outer`: the variable lives outside the procedure
@@ -1317,7 +1319,12 @@ Value push_onto_list(Value *place, const std::string &name, Value element, SrcLo
 Value assign(Value *place, const std::string &name, Value v, SrcLoc loc, bool outer,
              bool may_create, Frame *frame) {
   if (outer && is_pair(v) && eq(cdr(v), *place)) { // (set! l (cons x l)) on a run-time list
-    Value l = push_onto_list(place, name, car(v), loc, may_create, frame);
+    Value l = push_onto_list(place, name, car(v), loc, may_create, frame, false);
+    log_assignment(Assignment{place, *place, l, frame ? frame->serial : 0});
+    return l;
+  }
+  if (!outer && is_pair(v) && eq(cdr(v), *place) && grows_in_loop(frame)) {
+    Value l = push_onto_list(place, name, car(v), loc, true, frame, true);
     log_assignment(Assignment{place, *place, l, frame ? frame->serial : 0});
     return l;
   }
@@ -1454,6 +1461,8 @@ struct LoopParam {
 
 struct ActiveLoop {
   Closure *closure;
+  size_t depth = 0;        // g_open.size(): the function the loop is in
+  uint32_t serial = 0;     // g_frame_serial when the current attempt began
   bool watching = false;   // evaluated as an ordinary call until it calls itself
   gcvec<LoopParam> params; // holds Values: collected memory
   bool continued = false;
@@ -1619,10 +1628,16 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
     std::vector<RStmt> body;
     Value v;
     bool retry = false;
+    gcvec<Value> saved_lists;
+    for (Value *place : list_cell_places())
+      saved_lists.push_back(*place);
     gcvec<Assignment> assigned;
     {
       LoopAttempt attempt(&loop, &body);
       loop.continued = false;
+      loop.depth = g_open.size();
+      loop.serial = g_frame_serial;
+      read_list_cells(); // their lengths as each iteration begins
       gcvec<Value> args(slots, slots + n);
       for (long i = 0; i < n; ++i) {
         LoopParam &p = loop.params[i];
@@ -1656,7 +1671,12 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
         return false; // evaluated again as usual: the error, if real, comes again
       }
     } // the stacks are the caller's again
-    if (retry) continue;
+    for (size_t i = 0; i < saved_lists.size(); ++i)
+      *list_cell_places()[i] = saved_lists[i]; // read again after the loop if it added to them
+    if (retry) {
+      init_list_cells(); // lists the body conses onto start before the loop
+      continue;
+    }
     if (!g_undo.empty()) // an enclosing alternative undoes these assignments too
       for (const Assignment &a : assigned)
         log_assignment(a);
@@ -1682,6 +1702,7 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
       }
       for (RStmt &x : body)
         current_block().push_back(std::move(x));
+      if (calls) read_cells();
       *out = v;
       return true;
     }
@@ -1809,11 +1830,28 @@ Value count_plus(Value n, long k) {
   return k == 0 ? n : g_add(n, Value::fixnum(k));
 }
 
-// (set! l (cons element l)) in a procedure run at run time: add the element
-// to the run-time list l holds, or (l holding a list known at compile time)
-// start a new one, tracing the primitive again.
+// Is a variable of `frame` (null: a global) kept from one iteration to the
+// next of the loop being evaluated for run time, in the same function?
+bool grows_in_loop(Frame *frame) {
+  if (g_loops.empty()) return false;
+  const ActiveLoop *loop = g_loops.back();
+  return !loop->watching && loop->depth == g_open.size() &&
+         (!frame || frame->serial <= loop->serial);
+}
+
+// Evaluate again what added to a list that must first be started: the loop
+// that conses onto it, or the numerical primitive whose procedure does.
+[[noreturn]] void retry_for_list(bool in_loop) {
+  if (in_loop) throw LoopRetry{};
+  throw Retrace{};
+}
+
+// (set! l (cons element l)) in a procedure run at run time, or in a loop left
+// for run time (in_loop): add the element to the run-time list l holds, or
+// (l holding a list known at compile time) start a new one, tracing the
+// primitive (evaluating the loop) again.
 Value push_onto_list(Value *place, const std::string &name, Value element, SrcLoc loc,
-                     bool may_create, Frame *frame) {
+                     bool may_create, Frame *frame, bool in_loop) {
   int cell = list_cell_of(place);
   RtList *r = as_rtlist(*place);
   gcvec<Value> leaves;
@@ -1834,7 +1872,7 @@ Value push_onto_list(Value *place, const std::string &name, Value element, SrcLo
         cannot_compile(loc, "set! of " + name + " to a list of truth values and numbers");
       if (types[k] == RType::Integer) {
         types[k] = RType::Real; // counts widen to reals: trace again with real reads
-        throw Retrace{};
+        retry_for_list(in_loop);
       }
     }
     push_leaves(list, leaves);
@@ -1861,7 +1899,7 @@ Value push_onto_list(Value *place, const std::string &name, Value element, SrcLo
   g_list_cells[cell].needs_init = true;
   g_list_cells[cell].types = leaf_types(leaves);
   g_list_cell_elements[cell] = element_shape(element);
-  throw Retrace{};
+  retry_for_list(in_loop);
 }
 
 // Start the lists that pushes asked for, from the values their variables
