@@ -55,10 +55,15 @@ enum class RCompute : uint8_t {
   Truncate, // trunc(a[0])
   Max,      // fmax(a[0], a[1]) (NaN-propagating like MIT's max)
   Min,
-  RealTime, // milliseconds since the epoch, read when the statement runs
-  RunTime,  // processor seconds, read when the statement runs
-  Param,    // the program's --param `text`, or a[0]
-  ReadCell, // the current value of cell `cell`
+  RealTime,   // milliseconds since the epoch, read when the statement runs
+  RunTime,    // processor seconds, read when the statement runs
+  Param,      // the program's --param `text`, or a[0]
+  ReadCell,   // the current value of cell `cell`
+  ListLength, // the number of elements of list `list`
+  ListRef,  // leaf `leaf` of list `list`'s element at a[0], which must lie in [a[1], a[2]) (`text`
+            // names the caller)
+  ListFold, // min, max, + or * (`leaf`: sicm_list_fold_op) of list `list`'s numbers at [a[0],
+            // a[1]); `backward`
 };
 
 enum class RKind : uint8_t {
@@ -81,6 +86,8 @@ enum class RKind : uint8_t {
   Bisect,    // outs[0] = root of callee between args[0], args[1] to args[2]; number n-break
   Advance,   // outs = state args advanced by args.back() (dt); callee the derivative
   Evolve,    // outs = final state from args[0..dim) with monitor; dt t_final at the end
+  ListNew,   // list `list` = the empty list
+  ListPush,  // add args (an element's leaves) to list `list`
   Fail,      // never reached at compile time; unused for now
 };
 
@@ -89,15 +96,18 @@ struct RStmt {
   RKind kind;
   RCompute compute = RCompute::Expr;
   std::vector<ExprId> args;
-  std::vector<int> outs;                     // variable ids defined by the statement
-  std::vector<int> results;                  // Loop, Break: the loop's result variables
-  int var = -1;                              // Let, Print
-  int plot = -1;                             // plot statements: the plot's number
-  int callee = -1;                           // the function a numerical statement calls
-  int monitor = -1;                          // Evolve: the monitor function, or -1
-  int jacobian = -1;                         // Advance, Evolve: (D sysder) for implicit methods
-  int cell = -1;                             // SetCell, Let of ReadCell
-  double number = 0;                         // a tolerance
+  std::vector<int> outs;    // variable ids defined by the statement
+  std::vector<int> results; // Loop, Break: the loop's result variables
+  int var = -1;             // Let, Print
+  int plot = -1;            // plot statements: the plot's number
+  int callee = -1;          // the function a numerical statement calls
+  int monitor = -1;         // Evolve: the monitor function, or -1
+  int jacobian = -1;        // Advance, Evolve: (D sysder) for implicit methods
+  int cell = -1;            // SetCell, Let of ReadCell
+  int list = -1;            // ListNew, ListPush, Let of ListLength, ListRef, ListFold
+  int leaf = 0;             // Let of ListRef, ListFold
+  bool backward = false;    // Let of ListFold
+  double number = 0;        // a tolerance
   bool time_first = false, rate_one = false; // Advance, Evolve
   std::string method;                        // Advance, Evolve: the runtime's step type variable
   std::string text, title;
@@ -123,10 +133,20 @@ struct RCell {
   RType type;
 };
 
+// A list built at run time whose elements all have one shape: a C global
+// (listN, a sicm_list of `width` doubles per element; see sicm/program.h).
+// A list value at compile time is a range of positions in it (see
+// builtins_build.cpp).
+struct RList {
+  int width;
+  std::string name; // for comments
+};
+
 struct ResidualProgram {
   std::vector<RFunction> functions; // [0] is main
   std::vector<RVar> vars;
   std::vector<RCell> cells;
+  std::vector<RList> lists;
   int plots = 0;
   std::string source_name;             // the program's file name, for the executable's --help
   std::vector<std::string> parameters; // names declared by (parameter 'name default)

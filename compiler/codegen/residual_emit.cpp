@@ -49,6 +49,9 @@ std::string c_string_literal(std::string_view s) {
 
 namespace {
 
+const char *const kFoldOps[] = {"SICM_LIST_MIN", "SICM_LIST_MAX", "SICM_LIST_SUM",
+                                "SICM_LIST_PRODUCT"};
+
 std::string var_name(int id) {
   return "r" + std::to_string(id);
 }
@@ -77,6 +80,9 @@ public:
       out += "static sicm_plot *plot" + std::to_string(i) + ";\n";
     for (size_t i = 0; i < p_.cells.size(); ++i)
       out += "static double cell" + std::to_string(i) + ";\n";
+    for (size_t i = 0; i < p_.lists.size(); ++i)
+      out += "static sicm_list list" + std::to_string(i) + "; /* " +
+             sanitize_comment(p_.lists[i].name) + " */\n";
     out += sites_;
     out += "\n";
     for (size_t f = 1; f < p_.functions.size(); ++f)
@@ -333,6 +339,16 @@ private:
         e = "sicm_program_param(" + c_string_literal(s.text) + ", " + a[0] + ")";
         break;
       case RCompute::RunTime: e = "sicm_run_time()"; break;
+      case RCompute::ListLength: e = "sicm_list_length(&list" + std::to_string(s.list) + ")"; break;
+      case RCompute::ListRef:
+        e = "sicm_list_ref(" + site(s.loc) + ", " + c_string_literal(s.text) + ", &list" +
+            std::to_string(s.list) + ", " + a[0] + ", " + a[1] + ", " + a[2] + ", " +
+            std::to_string(s.leaf) + ")";
+        break;
+      case RCompute::ListFold:
+        e = "sicm_list_fold(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
+            kFoldOps[s.leaf] + ", " + a[0] + ", " + a[1] + ", " + (s.backward ? "1" : "0") + ")";
+        break;
       case RCompute::Min:
         e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmin(" + a[0] + ", " + a[1] + ")";
         break;
@@ -358,6 +374,16 @@ private:
       std::vector<std::string> a = args();
       code += "sicm_program_plot_line(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
               a[0] + ", " + a[1] + ", " + a[2] + ", " + a[3] + ");\n";
+      break;
+    }
+    case RKind::ListNew:
+      code += "sicm_list_reset(&list" + std::to_string(s.list) + ", " +
+              std::to_string(p_.lists[s.list].width) + ");\n";
+      break;
+    case RKind::ListPush: {
+      std::vector<std::string> a = args();
+      code += "sicm_list_push(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
+              (a.empty() ? std::string("NULL") : "(const double[]){" + join(a) + "}") + ");\n";
       break;
     }
     case RKind::Close: code += "sicm_plot_finish(plot" + std::to_string(s.plot) + ");\n"; break;

@@ -263,6 +263,12 @@ struct TailApply {
     Value last = eval(n->kids[nargs], env);
     if (list_length(last) < 0) {
       g_call_loc = n->loc;
+      TailApply t;
+      args.push_back(last);
+      if (g_dynamic_branch_hooks &&
+          g_dynamic_branch_hooks->apply_to_other(target, args.data(),
+                                                 static_cast<long>(args.size()), &t.result))
+        return t;
       wrong_type(last, static_cast<int>(nargs), "apply");
     }
     for (; is_pair(last); last = cdr(last))

@@ -110,6 +110,10 @@ struct DynamicBranchHooks {
   // kept): true and the result in *out if the hook evaluated the call itself
   // (as a loop left for run time), false to let the evaluator go on.
   bool (*call_closure)(Value f, Value *args, long nargs, Value *out);
+  // (apply f arg ... last) whose last argument is not a list known at compile
+  // time (args: all of them): true and the result in *out if the hook
+  // evaluated it, false for the usual error.
+  bool (*apply_to_other)(Value f, Value *args, long nargs, Value *out);
 };
 extern const DynamicBranchHooks *g_dynamic_branch_hooks;
 // Frames made so far (each frame records it as its serial).

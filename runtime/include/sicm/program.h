@@ -139,6 +139,51 @@ void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double
 void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure monitor,
                        double *y, double dt, double t_final);
 
+/* ---- lists whose length is known only at run time (list.c) ----
+ *
+ * A list the program builds at run time (a monitor consing each state onto a
+ * global, a map over such a list) whose elements all have one shape: each
+ * element is `width` doubles (the leaves of a number, a pair or an up/down
+ * structure of numbers). Elements are kept in the order they were added:
+ * data[i * width + leaf] is leaf `leaf` of the i-th element added. A Scheme
+ * list built by consing onto the front is the array read from the end; the
+ * compiler turns car, cdr, reverse, list-ref and length into positions in
+ * the array (a list value is a range [lo, hi) read forward or backward), so
+ * the runtime only stores and fetches. Positions are passed as doubles with
+ * integral values, as every run-time number is. */
+typedef struct {
+  double *data;
+  size_t len;   /* elements */
+  size_t cap;   /* elements allocated */
+  size_t width; /* doubles per element */
+} sicm_list;
+
+/* Empty the list (keeping its memory) for elements of `width` doubles. */
+void sicm_list_reset(sicm_list *list, size_t width);
+
+/* Add an element (width doubles) after the last; out of memory is a failure
+ * at `site`. */
+void sicm_list_push(const sicm_site *site, sicm_list *list, const double *element);
+
+/* The number of elements added since the last reset. */
+double sicm_list_length(const sicm_list *list);
+
+/* Leaf `leaf` of the element at `index`, which must lie in the range [lo, hi)
+ * the list value covers: otherwise a failure at `site` (WHO: the list is
+ * empty, or the index is out of range), as the interpreter's car or
+ * list-ref of a too short list is an error. */
+double sicm_list_ref(const sicm_site *site, const char *who, const sicm_list *list, double index,
+                     double lo, double hi, size_t leaf);
+
+/* (apply min l), (apply max l), (apply + l), (apply * l) of the numbers
+ * (width-1 elements) at positions [lo, hi), taken from hi - 1 down when
+ * `backward` (the order of a list built by consing), so that sums round as
+ * the interpreter's do: MIT's min and max (a NaN anywhere gives NaN); min or
+ * max of no number is a failure at `site`. */
+typedef enum { SICM_LIST_MIN, SICM_LIST_MAX, SICM_LIST_SUM, SICM_LIST_PRODUCT } sicm_list_fold_op;
+double sicm_list_fold(const sicm_site *site, const sicm_list *list, sicm_list_fold_op op, double lo,
+                      double hi, int backward);
+
 #ifdef __cplusplus
 }
 #endif
