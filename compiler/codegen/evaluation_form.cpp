@@ -119,19 +119,26 @@ bool read_polynomial(ExprId id, Poly *out) {
 
 // ---- building ---------------------------------------------------------------------
 
+// The arguments of (op a b), with the arguments of a or b spliced in where
+// that operand is itself an application of op.
+std::vector<ExprId> flattened(Op op, ExprId a, ExprId b) {
+  std::vector<ExprId> out;
+  for (ExprId x : {a, b}) {
+    if (expr_is_apply(x, op)) {
+      std::vector<ExprId> xs = expr_arg_vector(x);
+      out.insert(out.end(), xs.begin(), xs.end());
+    } else {
+      out.push_back(x);
+    }
+  }
+  return out;
+}
+
 // (* a b) with products flattened and a number kept first.
 ExprId multiply(ExprId a, ExprId b) {
   if (expr_is_exact_one(a)) return b;
   if (expr_is_exact_one(b)) return a;
-  std::vector<ExprId> factors;
-  for (ExprId x : {a, b}) {
-    if (expr_is_apply(x, Op::Mul)) {
-      std::vector<ExprId> xs = expr_arg_vector(x);
-      factors.insert(factors.end(), xs.begin(), xs.end());
-    } else {
-      factors.push_back(x);
-    }
-  }
+  std::vector<ExprId> factors = flattened(Op::Mul, a, b);
   auto numbers = std::stable_partition(factors.begin(), factors.end(),
                                        [](ExprId f) { return expr_is_number(f); });
   // Exact numeric factors fold into one: c * (-1 * x) is -c * x.
@@ -151,15 +158,7 @@ ExprId multiply(ExprId a, ExprId b) {
 
 // (+ a b) with sums flattened.
 ExprId add(ExprId a, ExprId b) {
-  std::vector<ExprId> terms;
-  for (ExprId x : {a, b}) {
-    if (expr_is_apply(x, Op::Add)) {
-      std::vector<ExprId> xs = expr_arg_vector(x);
-      terms.insert(terms.end(), xs.begin(), xs.end());
-    } else {
-      terms.push_back(x);
-    }
-  }
+  std::vector<ExprId> terms = flattened(Op::Add, a, b);
   return expr_apply(Op::Add, terms.data(), terms.size());
 }
 
