@@ -2167,6 +2167,221 @@ Value map_over_lists(Value f, Value *lists, int nlists, bool collect, const char
   return make_rtlist(out, true, false, Value::fixnum(0), n);
 }
 
+// ---- generalization: loops left for run time past the unroll limits ----------------------
+//
+// Evaluating a loop at compile time unrolls it: each iteration's run-time
+// work (a state advancer's call, a plot mark) is a statement of its own, so
+// the residual program grows with the iteration count. Past two named
+// limits (limits.hpp; flags of sicm build) the partial evaluator
+// generalizes instead, leaving the loop for run time (as Chez Scheme's cp0
+// residualizes past its effort limits). Hitting a limit is never an error:
+// if the generalized loop cannot be compiled (its body needs a value it now
+// gets only at run time), the loop is unrolled as before.
+//
+//   kMaxUnrolledElements    map or for-each over lists known at compile time
+//                           that are longer, of inexact numbers (or pairs or
+//                           structures of them, all of one shape), whose
+//                           procedure does run-time work on the first
+//                           elements (an evaluation that is then forgotten
+//                           records statements other than output text, or
+//                           gives a run-time value): the lists become
+//                           constant tables (RTable) copied into run-time
+//                           lists, and the map a C loop over them
+//                           (map_over_lists). Exact numbers stay known: they
+//                           print differently from doubles.
+//   kMaxUnrolledIterations  see "loops that start from known values" below.
+
+// Undoes what evaluating something tentatively made: the statements go to
+// `block`, assignments to older variables are logged, and roll_back forgets
+// the variables, functions, lists and tables it made.
+class Trial {
+public:
+  explicit Trial(std::vector<RStmt> *block)
+      : nfunctions_(g_prog->functions.size()), nvars_(g_prog->vars.size()),
+        nlists_(g_prog->lists.size()), ntables_(g_prog->tables.size()), nblocks_(g_blocks.size()),
+        nundo_(g_undo.size()) {
+    for (Value *place : list_cell_places())
+      saved_lists_.push_back(*place);
+    g_blocks.push_back(block);
+    g_undo.push_back(&log_);
+    g_undo_serials.push_back(g_frame_serial);
+  }
+  ~Trial() {
+    g_blocks.resize(nblocks_);
+    g_undo.resize(nundo_);
+    g_undo_serials.resize(nundo_);
+  }
+  Trial(const Trial &) = delete;
+  Trial &operator=(const Trial &) = delete;
+
+  void roll_back() {
+    for (auto a = log_.rbegin(); a != log_.rend(); ++a)
+      *a->place = a->before;
+    for (size_t v = nvars_; v < g_prog->vars.size(); ++v)
+      g_var_of.erase(g_prog->vars[v].sym);
+    g_prog->functions.resize(nfunctions_);
+    g_prog->vars.resize(nvars_);
+    g_prog->tables.resize(ntables_);
+    bool lists_in_use = false; // by a list cell started meanwhile
+    for (const ListCell &c : g_list_cells)
+      lists_in_use = lists_in_use || c.list >= static_cast<int>(nlists_);
+    if (!lists_in_use) {
+      g_prog->lists.resize(nlists_);
+      g_list_shapes.resize(nlists_);
+      g_list_types.resize(nlists_);
+    }
+    std::vector<Value *> places = list_cell_places();
+    for (size_t i = 0; i < saved_lists_.size() && i < places.size(); ++i)
+      *places[i] = saved_lists_[i];
+  }
+  size_t nfunctions() const { return nfunctions_; }
+  const gcvec<Assignment> &log() const { return log_; }
+
+private:
+  size_t nfunctions_, nvars_, nlists_, ntables_, nblocks_, nundo_;
+  gcvec<Assignment> log_;
+  gcvec<Value> saved_lists_;
+};
+
+// Keep what a Trial made, once it has ended: its statements follow in the
+// current block, and an enclosing alternative or loop undoes its
+// assignments too.
+void keep_trial(std::vector<RStmt> &block, const gcvec<Assignment> &assigned) {
+  if (!g_undo.empty())
+    for (const Assignment &a : assigned)
+      log_assignment(a);
+  for (RStmt &x : block)
+    current_block().push_back(std::move(x));
+}
+
+// Does applying f to args record run-time work (statements other than
+// output text, or a run-time result)? Evaluated and forgotten; false if it
+// fails (it fails again, where the caller evaluates it for real).
+bool does_run_time_work(Value f, gcvec<Value> args) {
+  std::vector<RStmt> block;
+  bool work = false;
+  Trial trial(&block);
+  try {
+    Value r = apply_procedure(f, args.data(), static_cast<int>(args.size()));
+    work = contains_dynamic(r) || g_prog->functions.size() > trial.nfunctions();
+    for (const RStmt &s : block)
+      work = work || s.kind != RKind::Text;
+  } catch (const Error &) {
+    work = false;
+  } catch (...) {
+    trial.roll_back();
+    throw;
+  }
+  trial.roll_back();
+  return work;
+}
+
+// An element a constant table can hold: an inexact number, or a pair or
+// up/down structure of such elements (a list of them ends in ()).
+bool inexact_tree(Value v, bool nil_ok) {
+  if (v.is(Tag::Flonum)) return true;
+  if (v.is(Tag::Nil)) return nil_ok;
+  if (is_pair(v)) return inexact_tree(car(v), false) && inexact_tree(cdr(v), true);
+  if (is_structure(v)) {
+    Structure *st = as_structure(v);
+    for (size_t i = 0; i < st->len; ++i)
+      if (!inexact_tree(st->items[i], false)) return false;
+    return st->len > 0;
+  }
+  return false;
+}
+
+// The first `count` elements of a list known at compile time as a table:
+// their leaves in order, and the first element (the shape of all). False if
+// they are not all inexact and of one shape.
+bool table_of(Value list, long count, Value *shape, std::vector<double> &data) {
+  Value x = list;
+  for (long k = 0; k < count; ++k, x = cdr(x)) {
+    Value e = car(x);
+    if (!inexact_tree(e, false)) return false;
+    if (k == 0) *shape = e;
+    if (k > 0 && !same_shape(e, *shape)) return false;
+    gcvec<Value> leaves;
+    element_leaves(e, leaves);
+    for (Value leaf : leaves)
+      data.push_back(leaf.d);
+  }
+  return true;
+}
+
+// A run-time list holding a table's elements (shaped like `shape`), copied
+// in where this statement runs.
+Value constant_list(Value shape, std::vector<double> data, long count, const char *who) {
+  gcvec<Value> leaves;
+  element_leaves(shape, leaves);
+  int width = static_cast<int>(leaves.size());
+  int table = -1;
+  for (size_t t = 0; t < g_prog->tables.size(); ++t)
+    if (g_prog->tables[t].width == width && g_prog->tables[t].data == data)
+      table = static_cast<int>(t);
+  if (table < 0) {
+    table = static_cast<int>(g_prog->tables.size());
+    g_prog->tables.push_back(RTable{width, std::move(data)});
+  }
+  int id = static_cast<int>(g_prog->lists.size());
+  g_prog->lists.push_back(RList{width, std::string("constant list for ") + who});
+  g_list_shapes.push_back(element_shape(shape));
+  g_list_types.push_back(std::vector<RType>(leaves.size(), RType::Real));
+  RStmt s{RKind::ListConst};
+  s.list = id;
+  s.leaf = table;
+  emit(std::move(s));
+  return make_rtlist(id, true, false, Value::fixnum(0), Value::fixnum(count));
+}
+
+// (map f l ...) or (for-each f l ...) over lists known at compile time, as
+// a C loop over constant tables when the lists are longer than
+// --max-unrolled-elements and f does run-time work (see above); false to
+// unroll it.
+bool map_over_static_lists(Value *a, int n, bool collect, const char *who, Value *out) {
+  uint64_t limit = current_limits().max_unrolled_elements;
+  if (n < 2 || !is_procedure(a[0]) || limit == kUnlimited) return false;
+  long count = -1;
+  for (int k = 1; k < n; ++k) {
+    long len = list_length(a[k]);
+    if (len < 0) return false;
+    count = count < 0 ? len : std::min(count, len);
+  }
+  if (count <= static_cast<long>(limit)) return false;
+  gcvec<Value> shapes, firsts;
+  std::vector<std::vector<double>> tables;
+  for (int k = 1; k < n; ++k) {
+    Value shape;
+    tables.emplace_back();
+    if (!table_of(a[k], count, &shape, tables.back())) return false;
+    shapes.push_back(shape);
+    firsts.push_back(car(a[k]));
+  }
+  if (!does_run_time_work(a[0], firsts)) return false;
+  std::vector<RStmt> block;
+  Value v;
+  gcvec<Assignment> assigned;
+  {
+    Trial trial(&block);
+    try {
+      gcvec<Value> views;
+      for (size_t k = 0; k < shapes.size(); ++k)
+        views.push_back(constant_list(shapes[k], std::move(tables[k]), count, who));
+      v = map_over_lists(a[0], views.data(), n - 1, collect, who);
+      assigned = trial.log();
+    } catch (const Error &) {
+      trial.roll_back();
+      return false; // unrolled: the error, if real, comes again
+    } catch (...) {
+      trial.roll_back();
+      throw;
+    }
+  }
+  keep_trial(block, assigned);
+  *out = v;
+  return true;
+}
+
 template <const char *Name, bool Collect> Value P_list_map(Value *a, int n) {
   bool any = false, all = true;
   for (int k = 1; k < n; ++k) {
@@ -2174,7 +2389,11 @@ template <const char *Name, bool Collect> Value P_list_map(Value *a, int n) {
     any = any || has_rtlist_tail(a[k]);
     all = all && rt;
   }
-  if (!any) return call_original(Name, a, n);
+  if (!any) {
+    Value v;
+    if (map_over_static_lists(a, n, Collect, Name, &v)) return v;
+    return call_original(Name, a, n);
+  }
   if (!all)
     cannot_compile(here(), std::string(Name) + " over a list whose length is known only at run "
                                                "time together with other lists");
