@@ -24,6 +24,16 @@
 //     known only at run time");
 //   - a run-time value where a static one is needed (a frame's bounds, a
 //     list index) or that escapes the procedure it was computed in.
+//
+// Loops whose iterations do run-time work are unrolled at compile time up to
+// two named limits (eval/limits.hpp, flags of sicm build), past which they
+// are generalized into C loops instead (never an error: see
+// "generalization" below):
+//   kMaxUnrolledElements   = 32  --max-unrolled-elements: map and for-each
+//                                over a longer list of inexact numbers;
+//   kMaxUnrolledIterations = 64  --max-unrolled-iterations: a named procedure
+//                                called with known arguments that calls
+//                                itself more often.
 #include "eval/build.hpp"
 
 #include <algorithm>
@@ -250,6 +260,8 @@ bool is_scalar(Value v) {
 // ---- statements ---------------------------------------------------------------------
 
 void read_cells();
+[[noreturn]] void throw_not_a_loop();
+uint64_t g_work = 0; // statements recorded other than output text (see StaticWatch)
 
 void emit(RStmt s) {
   if (!s.loc.known()) s.loc = here();
@@ -258,7 +270,12 @@ void emit(RStmt s) {
     body.back().text += s.text;
     return;
   }
+  // A statement after a loop's "continue" in the same block: the recursive
+  // call was not in tail position (its result is not the loop's), so the
+  // call is not a loop (LoopAbort is caught by the loop attempt).
+  if (!body.empty() && body.back().kind == RKind::Continue) throw_not_a_loop();
   note_residual_statement(s.loc); // --max-residual-size
+  if (s.kind != RKind::Text) ++g_work;
   bool calls = s.callee >= 0 || s.monitor >= 0;
   body.push_back(std::move(s));
   if (calls) read_cells(); // the call may have assigned them
@@ -1409,6 +1426,10 @@ Value hook_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc) {
 struct LoopRetry {}; // evaluate the loop's body again with more loop variables
 struct LoopAbort {}; // not a loop: evaluate the call as usual
 
+void throw_not_a_loop() {
+  throw LoopAbort{};
+}
+
 void write_bottom(std::string &out, const void *, bool) {
   out += "#[the value of a recursive call]";
 }
@@ -1475,6 +1496,7 @@ struct ActiveLoop {
   bool watching = false;   // evaluated as an ordinary call until it calls itself
   gcvec<LoopParam> params; // holds Values: collected memory
   bool continued = false;
+  bool from_known = false; // every argument of the first call was known (see StaticWatch)
 };
 
 struct BecomeLoop { // a watched call called itself: evaluate it as a loop
@@ -1511,6 +1533,14 @@ void make_variable(LoopParam &p, Value v) {
     p.types.push_back(scalar_type(leaf));
 }
 
+// A known value a loop started from known values may turn into a loop
+// variable: a truth value, an inexact number, or an exact integer that a
+// double holds exactly (an exact fraction prints differently from a double).
+bool is_loop_number(Value v) {
+  if (v.is(Tag::Flonum) || v.is(Tag::Bool) || is_dynamic_scalar(v)) return true;
+  return v.is(Tag::Fixnum) && v.i <= (int64_t(1) << 53) && v.i >= -(int64_t(1) << 53);
+}
+
 Value record_continue(ActiveLoop &loop, Value *a, long n) {
   RStmt s{RKind::Continue};
   for (long i = 0; i < n; ++i) {
@@ -1519,7 +1549,10 @@ Value record_continue(ActiveLoop &loop, Value *a, long n) {
       if (eqv(a[i], p.shape)) continue;
       gcvec<Value> leaves;
       if (!result_leaves(a[i], leaves) || !same_shape(a[i], p.shape))
-        throw LoopAbort{};    // a list that shrinks, ...
+        throw LoopAbort{}; // a list that shrinks, ...
+      if (loop.from_known)
+        for (Value leaf : leaves)
+          if (!is_loop_number(leaf)) throw LoopAbort{};
       make_variable(p, a[i]); // known numbers that change: loop variables
       throw LoopRetry{};
     }
@@ -1575,6 +1608,10 @@ private:
   gcvec<Assignment> log_;
 };
 
+bool evaluate_as_loop(Value f, Value *slots, long n, Value *out, bool from_known);
+bool watch_known_call(Value f, Value *slots, long n, Value *out);
+bool count_known_call(Closure *c);
+
 bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
   Closure *c = f.as<Closure>();
   for (auto l = g_loops.rbegin(); l != g_loops.rend(); ++l)
@@ -1587,7 +1624,10 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
   bool any = false;
   for (long i = 0; i < n; ++i)
     any = any || contains_dynamic(slots[i]) || is_dynamic_boolean(slots[i]);
-  if (!any) return false;
+  if (!any) {
+    if (count_known_call(c)) return false; // an iteration of a watched call
+    return watch_known_call(f, slots, n, out);
+  }
 
   // First as an ordinary call, watched: most calls never call themselves.
   {
@@ -1621,8 +1661,16 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
     }
   }
 
+  return evaluate_as_loop(f, slots, n, out, false);
+}
+
+// The call of closure f with arguments slots as a loop (see above);
+// from_known: all of them are known (see StaticWatch). False if it is not one.
+bool evaluate_as_loop(Value f, Value *slots, long n, Value *out, bool from_known) {
+  Closure *c = f.as<Closure>();
   ActiveLoop loop;
   loop.closure = c;
+  loop.from_known = from_known;
   for (long i = 0; i < n; ++i) {
     LoopParam p;
     p.shape = slots[i];
@@ -2250,8 +2298,13 @@ void keep_trial(std::vector<RStmt> &block, const gcvec<Assignment> &assigned) {
   if (!g_undo.empty())
     for (const Assignment &a : assigned)
       log_assignment(a);
-  for (RStmt &x : block)
-    current_block().push_back(std::move(x));
+  std::vector<RStmt> &to = current_block();
+  for (RStmt &x : block) {
+    if (x.kind == RKind::Text && !to.empty() && to.back().kind == RKind::Text)
+      to.back().text += x.text;
+    else
+      to.push_back(std::move(x));
+  }
 }
 
 // Does applying f to args record run-time work (statements other than
@@ -2380,6 +2433,89 @@ bool map_over_static_lists(Value *a, int n, bool collect, const char *who, Value
   keep_trial(block, assigned);
   *out = v;
   return true;
+}
+
+// ---- loops that start from known values -------------------------------------------------
+//
+// A named procedure called with known arguments runs at compile time, as in
+// sicm run: a loop of 500 iterations that plots a point in each leaves 500
+// plot statements. The outermost such call of a closure is watched (a
+// Trial): if the closure calls itself with known arguments more than
+// --max-unrolled-iterations (kMaxUnrolledIterations) times, and its calls
+// recorded run-time work (statements other than output text) within the
+// last half of that many calls, what the call did is forgotten and it is
+// evaluated again as a loop from the first call (evaluate_as_loop with
+// from_known): the known numbers that change from call to call become loop
+// variables. A loop that computes only known values runs at compile time
+// however long it is. If the call cannot be a loop (its recursive call is not
+// in tail position, a count is used where a known value is needed, ...) it
+// is evaluated as usual, unrolled, and no closure of its lambda is watched
+// again.
+
+struct StaticWatch {
+  Closure *closure;
+  uint64_t calls = 0;     // calls of the closure with known arguments while watched
+  uint64_t work_mark = 0; // g_work when the current window of calls began
+};
+struct UnrollLimit { // thrown to the watched call of `closure`
+  Closure *closure;
+};
+std::vector<StaticWatch *> g_watches;
+std::unordered_set<Lambda *> g_unrolled_lambdas; // whose loops could not be left for run time
+
+// A call of c with known arguments: if c is watched, count it (and throw
+// UnrollLimit past the limit) and say so.
+bool count_known_call(Closure *c) {
+  for (auto w = g_watches.rbegin(); w != g_watches.rend(); ++w) {
+    StaticWatch &watch = **w;
+    if (watch.closure != c) continue;
+    uint64_t limit = current_limits().max_unrolled_iterations;
+    uint64_t window = std::max<uint64_t>(1, limit / 2);
+    if (++watch.calls % window == 0) {
+      if (watch.calls >= limit && g_work > watch.work_mark) throw UnrollLimit{c};
+      watch.work_mark = g_work;
+    }
+    return true;
+  }
+  return false;
+}
+
+bool watch_known_call(Value f, Value *slots, long n, Value *out) {
+  Closure *c = f.as<Closure>();
+  if (current_limits().max_unrolled_iterations == kUnlimited || g_unrolled_lambdas.count(c->lambda))
+    return false;
+  StaticWatch watch{c, 0, g_work};
+  std::vector<RStmt> block;
+  Value v;
+  gcvec<Assignment> assigned;
+  bool limit_hit = false;
+  {
+    Trial trial(&block);
+    g_watches.push_back(&watch);
+    struct Pop {
+      ~Pop() { g_watches.pop_back(); }
+    } pop;
+    gcvec<Value> args(slots, slots + n);
+    try {
+      v = apply_procedure(f, args.data(), static_cast<int>(n));
+      assigned = trial.log();
+    } catch (const UnrollLimit &u) {
+      trial.roll_back();
+      if (u.closure != c) throw;
+      limit_hit = true;
+    } catch (...) {
+      trial.roll_back();
+      throw;
+    }
+  }
+  if (!limit_hit) {
+    keep_trial(block, assigned);
+    *out = v;
+    return true;
+  }
+  if (evaluate_as_loop(f, slots, n, out, true)) return true;
+  g_unrolled_lambdas.insert(c->lambda);
+  return false;
 }
 
 template <const char *Name, bool Collect> Value P_list_map(Value *a, int n) {
