@@ -4,7 +4,8 @@
 #   make check      install missing Debian packages, build, run every test
 #   make demo       install missing Debian packages, build, compile an example
 #                   scene with sicm build and run it (writes its SVG)
-#   make examples   run every figure scene at full size into build/figures
+#   make examples   build every figure scene at full size with sicm build,
+#                   run it, and write its plot into build/figures
 #   make install    install sicm under $(PREFIX)
 #   make clean
 #
@@ -118,10 +119,11 @@ demo: deps
 	$(BUILD)/demo/driven-pendulum --plot-dir $(BUILD)/demo
 	@echo "plot: $(BUILD)/demo/driven-pendulum.svg (data: $(BUILD)/demo/driven-pendulum.tsv)"
 
-# Every figure scene at full size, into $(BUILD)/figures.
+# Every figure scene at full size, built with sicm build and run, into
+# $(BUILD)/figures (scripts/run-examples without --build interprets them).
 examples: deps
 	@$(MAKE) --no-print-directory all
-	@scripts/run-examples --sicm $(SICM) --out $(BUILD)/figures
+	@scripts/run-examples --build --sicm $(SICM) --out $(BUILD)/figures
 
 # The libFuzzer targets of fuzz/, each for a few thousand inputs (needs clang).
 fuzz-smoke: deps

@@ -88,6 +88,7 @@ enum class RKind : uint8_t {
   Evolve,    // outs = final state from args[0..dim) with monitor; dt t_final at the end
   ListNew,   // list `list` = the empty list
   ListPush,  // add args (an element's leaves) to list `list`
+  ListConst, // list `list` = the elements of the constant table `leaf`
   Fail,      // never reached at compile time; unused for now
 };
 
@@ -105,7 +106,7 @@ struct RStmt {
   int jacobian = -1;        // Advance, Evolve: (D sysder) for implicit methods
   int cell = -1;            // SetCell, Let of ReadCell
   int list = -1;            // ListNew, ListPush, Let of ListLength, ListRef, ListFold
-  int leaf = 0;             // Let of ListRef, ListFold
+  int leaf = 0;             // Let of ListRef, ListFold; ListConst: the table
   bool backward = false;    // Let of ListFold
   double number = 0;        // a tolerance
   bool time_first = false, rate_one = false; // Advance, Evolve
@@ -142,11 +143,20 @@ struct RList {
   std::string name; // for comments
 };
 
+// A list known at compile time that a loop left for run time walks (a
+// for-each over 1000 initial points): a C array tableN of its elements'
+// leaves, `width` doubles per element, copied into a list by ListConst.
+struct RTable {
+  int width;
+  std::vector<double> data;
+};
+
 struct ResidualProgram {
   std::vector<RFunction> functions; // [0] is main
   std::vector<RVar> vars;
   std::vector<RCell> cells;
   std::vector<RList> lists;
+  std::vector<RTable> tables;
   int plots = 0;
   std::string source_name;             // the program's file name, for the executable's --help
   std::vector<std::string> parameters; // names declared by (parameter 'name default)

@@ -83,6 +83,8 @@ public:
     for (size_t i = 0; i < p_.lists.size(); ++i)
       out += "static sicm_list list" + std::to_string(i) + "; /* " +
              sanitize_comment(p_.lists[i].name) + " */\n";
+    for (size_t i = 0; i < p_.tables.size(); ++i)
+      out += table(i);
     out += sites_;
     out += "\n";
     for (size_t f = 1; f < p_.functions.size(); ++f)
@@ -102,6 +104,16 @@ public:
   }
 
 private:
+  // A constant table: four numbers a line.
+  std::string table(size_t i) {
+    const RTable &t = p_.tables[i];
+    std::string out = "static const double table" + std::to_string(i) + "[" +
+                      std::to_string(std::max<size_t>(t.data.size(), 1)) + "] = {";
+    for (size_t k = 0; k < t.data.size(); ++k)
+      out += (k % 4 ? " " : "\n  ") + c_double_literal(t.data[k]) + ",";
+    return out + "\n};\n";
+  }
+
   // ---- pass 1: liveness and captures ----
 
   void refs_of(ExprId root, const RStmt *where, std::set<int> &out) {
@@ -384,6 +396,14 @@ private:
       std::vector<std::string> a = args();
       code += "sicm_list_push(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
               (a.empty() ? std::string("NULL") : "(const double[]){" + join(a) + "}") + ");\n";
+      break;
+    }
+    case RKind::ListConst: {
+      const RTable &t = p_.tables[static_cast<size_t>(s.leaf)];
+      size_t count = t.width ? t.data.size() / static_cast<size_t>(t.width) : 0;
+      code += "sicm_list_assign(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
+              std::to_string(t.width) + ", table" + std::to_string(s.leaf) + ", " +
+              std::to_string(count) + ");\n";
       break;
     }
     case RKind::Close: code += "sicm_plot_finish(plot" + std::to_string(s.plot) + ");\n"; break;

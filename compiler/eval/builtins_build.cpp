@@ -24,6 +24,16 @@
 //     known only at run time");
 //   - a run-time value where a static one is needed (a frame's bounds, a
 //     list index) or that escapes the procedure it was computed in.
+//
+// Loops whose iterations do run-time work are unrolled at compile time up to
+// two named limits (eval/limits.hpp, flags of sicm build), past which they
+// are generalized into C loops instead (never an error: see
+// "generalization" below):
+//   kMaxUnrolledElements   = 32  --max-unrolled-elements: map and for-each
+//                                over a longer list of inexact numbers;
+//   kMaxUnrolledIterations = 64  --max-unrolled-iterations: a named procedure
+//                                called with known arguments that calls
+//                                itself more often.
 #include "eval/build.hpp"
 
 #include <algorithm>
@@ -250,6 +260,8 @@ bool is_scalar(Value v) {
 // ---- statements ---------------------------------------------------------------------
 
 void read_cells();
+[[noreturn]] void throw_not_a_loop();
+uint64_t g_work = 0; // statements recorded other than output text (see StaticWatch)
 
 void emit(RStmt s) {
   if (!s.loc.known()) s.loc = here();
@@ -258,7 +270,12 @@ void emit(RStmt s) {
     body.back().text += s.text;
     return;
   }
+  // A statement after a loop's "continue" in the same block: the recursive
+  // call was not in tail position (its result is not the loop's), so the
+  // call is not a loop (LoopAbort is caught by the loop attempt).
+  if (!body.empty() && body.back().kind == RKind::Continue) throw_not_a_loop();
   note_residual_statement(s.loc); // --max-residual-size
+  if (s.kind != RKind::Text) ++g_work;
   bool calls = s.callee >= 0 || s.monitor >= 0;
   body.push_back(std::move(s));
   if (calls) read_cells(); // the call may have assigned them
@@ -1409,6 +1426,10 @@ Value hook_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc) {
 struct LoopRetry {}; // evaluate the loop's body again with more loop variables
 struct LoopAbort {}; // not a loop: evaluate the call as usual
 
+void throw_not_a_loop() {
+  throw LoopAbort{};
+}
+
 void write_bottom(std::string &out, const void *, bool) {
   out += "#[the value of a recursive call]";
 }
@@ -1475,6 +1496,7 @@ struct ActiveLoop {
   bool watching = false;   // evaluated as an ordinary call until it calls itself
   gcvec<LoopParam> params; // holds Values: collected memory
   bool continued = false;
+  bool from_known = false; // every argument of the first call was known (see StaticWatch)
 };
 
 struct BecomeLoop { // a watched call called itself: evaluate it as a loop
@@ -1511,6 +1533,14 @@ void make_variable(LoopParam &p, Value v) {
     p.types.push_back(scalar_type(leaf));
 }
 
+// A known value a loop started from known values may turn into a loop
+// variable: a truth value, an inexact number, or an exact integer that a
+// double holds exactly (an exact fraction prints differently from a double).
+bool is_loop_number(Value v) {
+  if (v.is(Tag::Flonum) || v.is(Tag::Bool) || is_dynamic_scalar(v)) return true;
+  return v.is(Tag::Fixnum) && v.i <= (int64_t(1) << 53) && v.i >= -(int64_t(1) << 53);
+}
+
 Value record_continue(ActiveLoop &loop, Value *a, long n) {
   RStmt s{RKind::Continue};
   for (long i = 0; i < n; ++i) {
@@ -1519,7 +1549,10 @@ Value record_continue(ActiveLoop &loop, Value *a, long n) {
       if (eqv(a[i], p.shape)) continue;
       gcvec<Value> leaves;
       if (!result_leaves(a[i], leaves) || !same_shape(a[i], p.shape))
-        throw LoopAbort{};    // a list that shrinks, ...
+        throw LoopAbort{}; // a list that shrinks, ...
+      if (loop.from_known)
+        for (Value leaf : leaves)
+          if (!is_loop_number(leaf)) throw LoopAbort{};
       make_variable(p, a[i]); // known numbers that change: loop variables
       throw LoopRetry{};
     }
@@ -1575,6 +1608,10 @@ private:
   gcvec<Assignment> log_;
 };
 
+bool evaluate_as_loop(Value f, Value *slots, long n, Value *out, bool from_known);
+bool watch_known_call(Value f, Value *slots, long n, Value *out);
+bool count_known_call(Closure *c);
+
 bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
   Closure *c = f.as<Closure>();
   for (auto l = g_loops.rbegin(); l != g_loops.rend(); ++l)
@@ -1587,7 +1624,10 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
   bool any = false;
   for (long i = 0; i < n; ++i)
     any = any || contains_dynamic(slots[i]) || is_dynamic_boolean(slots[i]);
-  if (!any) return false;
+  if (!any) {
+    if (count_known_call(c)) return false; // an iteration of a watched call
+    return watch_known_call(f, slots, n, out);
+  }
 
   // First as an ordinary call, watched: most calls never call themselves.
   {
@@ -1621,8 +1661,16 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
     }
   }
 
+  return evaluate_as_loop(f, slots, n, out, false);
+}
+
+// The call of closure f with arguments slots as a loop (see above);
+// from_known: all of them are known (see StaticWatch). False if it is not one.
+bool evaluate_as_loop(Value f, Value *slots, long n, Value *out, bool from_known) {
+  Closure *c = f.as<Closure>();
   ActiveLoop loop;
   loop.closure = c;
+  loop.from_known = from_known;
   for (long i = 0; i < n; ++i) {
     LoopParam p;
     p.shape = slots[i];
@@ -2167,6 +2215,309 @@ Value map_over_lists(Value f, Value *lists, int nlists, bool collect, const char
   return make_rtlist(out, true, false, Value::fixnum(0), n);
 }
 
+// ---- generalization: loops left for run time past the unroll limits ----------------------
+//
+// Evaluating a loop at compile time unrolls it: each iteration's run-time
+// work (a state advancer's call, a plot mark) is a statement of its own, so
+// the residual program grows with the iteration count. Past two named
+// limits (limits.hpp; flags of sicm build) the partial evaluator
+// generalizes instead, leaving the loop for run time (as Chez Scheme's cp0
+// residualizes past its effort limits). Hitting a limit is never an error:
+// if the generalized loop cannot be compiled (its body needs a value it now
+// gets only at run time), the loop is unrolled as before.
+//
+//   kMaxUnrolledElements    map or for-each over lists known at compile time
+//                           that are longer, of inexact numbers (or pairs or
+//                           structures of them, all of one shape), whose
+//                           procedure does run-time work on the first
+//                           elements (an evaluation that is then forgotten
+//                           records statements other than output text, or
+//                           gives a run-time value): the lists become
+//                           constant tables (RTable) copied into run-time
+//                           lists, and the map a C loop over them
+//                           (map_over_lists). Exact numbers stay known: they
+//                           print differently from doubles.
+//   kMaxUnrolledIterations  see "loops that start from known values" below.
+
+// Undoes what evaluating something tentatively made: the statements go to
+// `block`, assignments to older variables are logged, and roll_back forgets
+// the variables, functions, lists and tables it made.
+class Trial {
+public:
+  explicit Trial(std::vector<RStmt> *block)
+      : nfunctions_(g_prog->functions.size()), nvars_(g_prog->vars.size()),
+        nlists_(g_prog->lists.size()), ntables_(g_prog->tables.size()), nblocks_(g_blocks.size()),
+        nundo_(g_undo.size()) {
+    for (Value *place : list_cell_places())
+      saved_lists_.push_back(*place);
+    g_blocks.push_back(block);
+    g_undo.push_back(&log_);
+    g_undo_serials.push_back(g_frame_serial);
+  }
+  ~Trial() {
+    g_blocks.resize(nblocks_);
+    g_undo.resize(nundo_);
+    g_undo_serials.resize(nundo_);
+  }
+  Trial(const Trial &) = delete;
+  Trial &operator=(const Trial &) = delete;
+
+  void roll_back() {
+    for (auto a = log_.rbegin(); a != log_.rend(); ++a)
+      *a->place = a->before;
+    for (size_t v = nvars_; v < g_prog->vars.size(); ++v)
+      g_var_of.erase(g_prog->vars[v].sym);
+    g_prog->functions.resize(nfunctions_);
+    g_prog->vars.resize(nvars_);
+    g_prog->tables.resize(ntables_);
+    bool lists_in_use = false; // by a list cell started meanwhile
+    for (const ListCell &c : g_list_cells)
+      lists_in_use = lists_in_use || c.list >= static_cast<int>(nlists_);
+    if (!lists_in_use) {
+      g_prog->lists.resize(nlists_);
+      g_list_shapes.resize(nlists_);
+      g_list_types.resize(nlists_);
+    }
+    std::vector<Value *> places = list_cell_places();
+    for (size_t i = 0; i < saved_lists_.size() && i < places.size(); ++i)
+      *places[i] = saved_lists_[i];
+  }
+  size_t nfunctions() const { return nfunctions_; }
+  const gcvec<Assignment> &log() const { return log_; }
+
+private:
+  size_t nfunctions_, nvars_, nlists_, ntables_, nblocks_, nundo_;
+  gcvec<Assignment> log_;
+  gcvec<Value> saved_lists_;
+};
+
+// Keep what a Trial made, once it has ended: its statements follow in the
+// current block, and an enclosing alternative or loop undoes its
+// assignments too.
+void keep_trial(std::vector<RStmt> &block, const gcvec<Assignment> &assigned) {
+  if (!g_undo.empty())
+    for (const Assignment &a : assigned)
+      log_assignment(a);
+  std::vector<RStmt> &to = current_block();
+  for (RStmt &x : block) {
+    if (x.kind == RKind::Text && !to.empty() && to.back().kind == RKind::Text)
+      to.back().text += x.text;
+    else
+      to.push_back(std::move(x));
+  }
+}
+
+// Does applying f to args record run-time work (statements other than
+// output text, or a run-time result)? Evaluated and forgotten; false if it
+// fails (it fails again, where the caller evaluates it for real).
+bool does_run_time_work(Value f, gcvec<Value> args) {
+  std::vector<RStmt> block;
+  bool work = false;
+  Trial trial(&block);
+  try {
+    Value r = apply_procedure(f, args.data(), static_cast<int>(args.size()));
+    work = contains_dynamic(r) || g_prog->functions.size() > trial.nfunctions();
+    for (const RStmt &s : block)
+      work = work || s.kind != RKind::Text;
+  } catch (const Error &) {
+    work = false;
+  } catch (...) {
+    trial.roll_back();
+    throw;
+  }
+  trial.roll_back();
+  return work;
+}
+
+// An element a constant table can hold: an inexact number, or a pair or
+// up/down structure of such elements (a list of them ends in ()).
+bool inexact_tree(Value v, bool nil_ok) {
+  if (v.is(Tag::Flonum)) return true;
+  if (v.is(Tag::Nil)) return nil_ok;
+  if (is_pair(v)) return inexact_tree(car(v), false) && inexact_tree(cdr(v), true);
+  if (is_structure(v)) {
+    Structure *st = as_structure(v);
+    for (size_t i = 0; i < st->len; ++i)
+      if (!inexact_tree(st->items[i], false)) return false;
+    return st->len > 0;
+  }
+  return false;
+}
+
+// The first `count` elements of a list known at compile time as a table:
+// their leaves in order, and the first element (the shape of all). False if
+// they are not all inexact and of one shape.
+bool table_of(Value list, long count, Value *shape, std::vector<double> &data) {
+  Value x = list;
+  for (long k = 0; k < count; ++k, x = cdr(x)) {
+    Value e = car(x);
+    if (!inexact_tree(e, false)) return false;
+    if (k == 0) *shape = e;
+    if (k > 0 && !same_shape(e, *shape)) return false;
+    gcvec<Value> leaves;
+    element_leaves(e, leaves);
+    for (Value leaf : leaves)
+      data.push_back(leaf.d);
+  }
+  return true;
+}
+
+// A run-time list holding a table's elements (shaped like `shape`), copied
+// in where this statement runs.
+Value constant_list(Value shape, std::vector<double> data, long count, const char *who) {
+  gcvec<Value> leaves;
+  element_leaves(shape, leaves);
+  int width = static_cast<int>(leaves.size());
+  int table = -1;
+  for (size_t t = 0; t < g_prog->tables.size(); ++t)
+    if (g_prog->tables[t].width == width && g_prog->tables[t].data == data)
+      table = static_cast<int>(t);
+  if (table < 0) {
+    table = static_cast<int>(g_prog->tables.size());
+    g_prog->tables.push_back(RTable{width, std::move(data)});
+  }
+  int id = static_cast<int>(g_prog->lists.size());
+  g_prog->lists.push_back(RList{width, std::string("constant list for ") + who});
+  g_list_shapes.push_back(element_shape(shape));
+  g_list_types.push_back(std::vector<RType>(leaves.size(), RType::Real));
+  RStmt s{RKind::ListConst};
+  s.list = id;
+  s.leaf = table;
+  emit(std::move(s));
+  return make_rtlist(id, true, false, Value::fixnum(0), Value::fixnum(count));
+}
+
+// (map f l ...) or (for-each f l ...) over lists known at compile time, as
+// a C loop over constant tables when the lists are longer than
+// --max-unrolled-elements and f does run-time work (see above); false to
+// unroll it.
+bool map_over_static_lists(Value *a, int n, bool collect, const char *who, Value *out) {
+  uint64_t limit = current_limits().max_unrolled_elements;
+  if (n < 2 || !is_procedure(a[0]) || limit == kUnlimited) return false;
+  long count = -1;
+  for (int k = 1; k < n; ++k) {
+    long len = list_length(a[k]);
+    if (len < 0) return false;
+    count = count < 0 ? len : std::min(count, len);
+  }
+  if (count <= static_cast<long>(limit)) return false;
+  gcvec<Value> shapes, firsts;
+  std::vector<std::vector<double>> tables;
+  for (int k = 1; k < n; ++k) {
+    Value shape;
+    tables.emplace_back();
+    if (!table_of(a[k], count, &shape, tables.back())) return false;
+    shapes.push_back(shape);
+    firsts.push_back(car(a[k]));
+  }
+  if (!does_run_time_work(a[0], firsts)) return false;
+  std::vector<RStmt> block;
+  Value v;
+  gcvec<Assignment> assigned;
+  {
+    Trial trial(&block);
+    try {
+      gcvec<Value> views;
+      for (size_t k = 0; k < shapes.size(); ++k)
+        views.push_back(constant_list(shapes[k], std::move(tables[k]), count, who));
+      v = map_over_lists(a[0], views.data(), n - 1, collect, who);
+      assigned = trial.log();
+    } catch (const Error &) {
+      trial.roll_back();
+      return false; // unrolled: the error, if real, comes again
+    } catch (...) {
+      trial.roll_back();
+      throw;
+    }
+  }
+  keep_trial(block, assigned);
+  *out = v;
+  return true;
+}
+
+// ---- loops that start from known values -------------------------------------------------
+//
+// A named procedure called with known arguments runs at compile time, as in
+// sicm run: a loop of 500 iterations that plots a point in each leaves 500
+// plot statements. The outermost such call of a closure is watched (a
+// Trial): if the closure calls itself with known arguments more than
+// --max-unrolled-iterations (kMaxUnrolledIterations) times, and its calls
+// recorded run-time work (statements other than output text) within the
+// last half of that many calls, what the call did is forgotten and it is
+// evaluated again as a loop from the first call (evaluate_as_loop with
+// from_known): the known numbers that change from call to call become loop
+// variables. A loop that computes only known values runs at compile time
+// however long it is. If the call cannot be a loop (its recursive call is not
+// in tail position, a count is used where a known value is needed, ...) it
+// is evaluated as usual, unrolled, and no closure of its lambda is watched
+// again.
+
+struct StaticWatch {
+  Closure *closure;
+  uint64_t calls = 0;     // calls of the closure with known arguments while watched
+  uint64_t work_mark = 0; // g_work when the current window of calls began
+};
+struct UnrollLimit { // thrown to the watched call of `closure`
+  Closure *closure;
+};
+std::vector<StaticWatch *> g_watches;
+std::unordered_set<Lambda *> g_unrolled_lambdas; // whose loops could not be left for run time
+
+// A call of c with known arguments: if c is watched, count it (and throw
+// UnrollLimit past the limit) and say so.
+bool count_known_call(Closure *c) {
+  for (auto w = g_watches.rbegin(); w != g_watches.rend(); ++w) {
+    StaticWatch &watch = **w;
+    if (watch.closure != c) continue;
+    uint64_t limit = current_limits().max_unrolled_iterations;
+    uint64_t window = std::max<uint64_t>(1, limit / 2);
+    if (++watch.calls % window == 0) {
+      if (watch.calls >= limit && g_work > watch.work_mark) throw UnrollLimit{c};
+      watch.work_mark = g_work;
+    }
+    return true;
+  }
+  return false;
+}
+
+bool watch_known_call(Value f, Value *slots, long n, Value *out) {
+  Closure *c = f.as<Closure>();
+  if (current_limits().max_unrolled_iterations == kUnlimited || g_unrolled_lambdas.count(c->lambda))
+    return false;
+  StaticWatch watch{c, 0, g_work};
+  std::vector<RStmt> block;
+  Value v;
+  gcvec<Assignment> assigned;
+  bool limit_hit = false;
+  {
+    Trial trial(&block);
+    g_watches.push_back(&watch);
+    struct Pop {
+      ~Pop() { g_watches.pop_back(); }
+    } pop;
+    gcvec<Value> args(slots, slots + n);
+    try {
+      v = apply_procedure(f, args.data(), static_cast<int>(n));
+      assigned = trial.log();
+    } catch (const UnrollLimit &u) {
+      trial.roll_back();
+      if (u.closure != c) throw;
+      limit_hit = true;
+    } catch (...) {
+      trial.roll_back();
+      throw;
+    }
+  }
+  if (!limit_hit) {
+    keep_trial(block, assigned);
+    *out = v;
+    return true;
+  }
+  if (evaluate_as_loop(f, slots, n, out, true)) return true;
+  g_unrolled_lambdas.insert(c->lambda);
+  return false;
+}
+
 template <const char *Name, bool Collect> Value P_list_map(Value *a, int n) {
   bool any = false, all = true;
   for (int k = 1; k < n; ++k) {
@@ -2174,7 +2525,11 @@ template <const char *Name, bool Collect> Value P_list_map(Value *a, int n) {
     any = any || has_rtlist_tail(a[k]);
     all = all && rt;
   }
-  if (!any) return call_original(Name, a, n);
+  if (!any) {
+    Value v;
+    if (map_over_static_lists(a, n, Collect, Name, &v)) return v;
+    return call_original(Name, a, n);
+  }
   if (!all)
     cannot_compile(here(), std::string(Name) + " over a list whose length is known only at run "
                                                "time together with other lists");

@@ -29,6 +29,9 @@
 //               evaluation that recurses through a primitive (map, sort)
 //               really does use more of the resource being limited.
 //   residual    sicm build counts the statements it records.
+//   unrolling   not errors: sicm build reads --max-unrolled-elements and
+//               --max-unrolled-iterations (current_limits) to decide when to
+//               leave a loop for run time instead of unrolling it.
 //
 // Once a limit is hit every later check of it fails too (the step count
 // stays past the limit, the interrupt flag stays set), so an error caught on
@@ -92,7 +95,13 @@ constexpr size_t kMinStackBytes = size_t(256) << 20;
 // millisecond, large enough that the checkpoint costs nothing measurable.
 constexpr int64_t kCheckInterval = 4096;
 
-Limits g_limits = {kUnlimited, 0, kUnlimited, kUnlimited, kUnlimited};
+Limits g_limits = {kUnlimited,
+                   0,
+                   kUnlimited,
+                   kUnlimited,
+                   kUnlimited,
+                   kMaxUnrolledElements,
+                   kMaxUnrolledIterations};
 bool g_compile_time = false;
 bool g_active = false; // set_limits has run
 uint64_t g_steps_base = 0;
@@ -179,6 +188,8 @@ const Flag kFlags[] = {
     {"--max-expression-nodes", &Limits::max_expression_nodes, false, true},
     {"--max-recursion-depth", &Limits::max_recursion_depth, false, false},
     {"--max-residual-size", &Limits::max_residual_size, false, true},
+    {"--max-unrolled-elements", &Limits::max_unrolled_elements, false, true},
+    {"--max-unrolled-iterations", &Limits::max_unrolled_iterations, false, true},
 };
 
 // The largest recursion depth accepted (the stack grows with it).
@@ -272,6 +283,8 @@ Limits with_defaults(Limits given, bool compile_time) {
   if (!l.max_expression_nodes) l.max_expression_nodes = kDefaultExpressionNodes;
   if (!l.max_recursion_depth) l.max_recursion_depth = kDefaultRecursionDepth;
   if (!l.max_residual_size) l.max_residual_size = kDefaultResidualSize;
+  if (!l.max_unrolled_elements) l.max_unrolled_elements = kMaxUnrolledElements;
+  if (!l.max_unrolled_iterations) l.max_unrolled_iterations = kMaxUnrolledIterations;
   return l;
 }
 
@@ -332,7 +345,18 @@ std::string limits_usage() {
          show_count(kDefaultRecursionDepth) +
          "\n"
          "  --max-residual-size=N     statements of a built program; default " +
-         show_count(kDefaultResidualSize) + "\n";
+         show_count(kDefaultResidualSize) +
+         "\n"
+         "  --max-unrolled-elements=N build: map and for-each over a longer list of\n"
+         "                            inexact numbers known at compile time become a C\n"
+         "                            loop when they do run-time work; default " +
+         show_count(kMaxUnrolledElements) +
+         "\n"
+         "  --max-unrolled-iterations=N\n"
+         "                            build: a loop that starts from known values and\n"
+         "                            does run-time work is unrolled this far, then left\n"
+         "                            for run time as a C loop; default " +
+         show_count(kMaxUnrolledIterations) + "\n";
 }
 
 size_t recursion_stack_bytes(const Limits &limits) {
@@ -389,6 +413,10 @@ void note_residual_statement(SrcLoc where) {
 void stack_exhausted(SrcLoc where) {
   limit_error(where, "Aborting!: maximum recursion depth exceeded (--max-recursion-depth=" +
                          show_count(g_limits.max_recursion_depth) + ")");
+}
+
+const Limits &current_limits() {
+  return g_limits;
 }
 
 uint64_t steps_taken() {

@@ -4,6 +4,10 @@
 // Every limit is a command-line flag with a documented default. Hitting one
 // is an Error naming the limit and its flag, at the place evaluation had
 // reached, so `sicm run` exits 70, `sicm build` 65 and the REPL carries on.
+//
+// The unroll limits of sicm build are different: hitting one is never an
+// error. Past them the partial evaluator generalizes (leaves a loop for run
+// time) instead of unrolling it (see eval/builtins_build.cpp).
 #pragma once
 
 #include <atomic>
@@ -20,12 +24,29 @@ constexpr uint64_t kUnlimited = UINT64_MAX;
 
 // A value of 0 stands for "the default" until with_defaults fills it in.
 struct Limits {
-  uint64_t max_steps = 0;            // iterations of the evaluator's loop
-  uint64_t max_memory = 0;           // bytes of collected heap
-  uint64_t max_expression_nodes = 0; // new nodes in the expression arena
-  uint64_t max_recursion_depth = 0;  // levels of non-tail recursion
-  uint64_t max_residual_size = 0;    // statements of a built program
+  uint64_t max_steps = 0;               // iterations of the evaluator's loop
+  uint64_t max_memory = 0;              // bytes of collected heap
+  uint64_t max_expression_nodes = 0;    // new nodes in the expression arena
+  uint64_t max_recursion_depth = 0;     // levels of non-tail recursion
+  uint64_t max_residual_size = 0;       // statements of a built program
+  uint64_t max_unrolled_elements = 0;   // sicm build: see kMaxUnrolledElements
+  uint64_t max_unrolled_iterations = 0; // sicm build: see kMaxUnrolledIterations
 };
+
+// sicm build unrolls map and for-each over a list known at compile time
+// whose body does run-time work (calls a numerical primitive, plots) only
+// for lists of at most this many elements; a longer list of inexact numbers
+// (or of pairs or structures of them, all of one shape) becomes a constant
+// table in the executable and the body a C loop over it
+// (--max-unrolled-elements).
+constexpr uint64_t kMaxUnrolledElements = 32;
+// sicm build evaluates a named procedure called with arguments known at
+// compile time as sicm run does, unrolling its recursion, until it has
+// called itself this many times while its calls record run-time work; then
+// it evaluates the first call again as a C loop whose variables are the
+// arguments that change from call to call (--max-unrolled-iterations).
+// Loops that do no run-time work run at compile time however long they are.
+constexpr uint64_t kMaxUnrolledIterations = 64;
 
 // The limits given, with the defaults of a command in place of the rest.
 // compile_time: build and emit-c, whose steps are limited by default too.
@@ -65,6 +86,9 @@ void request_interrupt();
 // sicm build: one more statement in the residual program, emitted at
 // `where`; raises the residual size error past the limit.
 void note_residual_statement(SrcLoc where);
+
+// The limits in force (with defaults filled in), as set_limits set them.
+const Limits &current_limits();
 
 // Steps taken since the evaluation began (for tests and measurements).
 uint64_t steps_taken();

@@ -31,6 +31,13 @@ void sicm_list_push(const sicm_site *site, sicm_list *list, const double *elemen
   ++list->len;
 }
 
+void sicm_list_assign(const sicm_site *site, sicm_list *list, size_t width, const double *data,
+                      size_t len) {
+  sicm_list_reset(list, width);
+  for (size_t i = 0; i < len; ++i)
+    sicm_list_push(site, list, data + i * width);
+}
+
 double sicm_list_length(const sicm_list *list) {
   return (double)list->len;
 }

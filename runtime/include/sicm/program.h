@@ -165,6 +165,12 @@ void sicm_list_reset(sicm_list *list, size_t width);
  * at `site`. */
 void sicm_list_push(const sicm_site *site, sicm_list *list, const double *element);
 
+/* Reset the list for elements of `width` doubles and add the `len` elements
+ * of `data` (a constant table: a list known at compile time that a loop
+ * walks at run time); out of memory is a failure at `site`. */
+void sicm_list_assign(const sicm_site *site, sicm_list *list, size_t width, const double *data,
+                      size_t len);
+
 /* The number of elements added since the last reset. */
 double sicm_list_length(const sicm_list *list);
 
