@@ -147,9 +147,12 @@ int build_program(const BuildOptions &o) {
     }
   }
   std::vector<std::string> argv = compiler_command();
-  argv.insert(argv.end(),
-              {"-std=c11", o.opt_level, "-o", o.output, c_path, "-I" + include_dir, library,
-               "-lsundials_cvode", "-lsundials_nvecserial", "-lgsl", "-lgslcblas", "-lm"});
+  // The generated C never needs to shadow a name: a declaration that hides a
+  // hoisted variable once made a built program print 0. where sicm run
+  // printed the value. -Werror=shadow makes such a bug fail the build.
+  argv.insert(argv.end(), {"-std=c11", "-Werror=shadow", o.opt_level, "-o", o.output, c_path,
+                           "-I" + include_dir, library, "-lsundials_cvode", "-lsundials_nvecserial",
+                           "-lgsl", "-lgslcblas", "-lm"});
   std::vector<std::string> sanitize = sanitizer_flags();
   argv.insert(argv.begin() + 1, sanitize.begin(), sanitize.end());
   int status = run(argv);

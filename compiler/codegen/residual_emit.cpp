@@ -299,13 +299,14 @@ private:
            c_double_literal(s.number) + ", " + closure(s.jacobian) + "}";
   }
 
-  // Declarations of the used outputs of a statement from an array.
+  // The used outputs of a statement from an array: declared here, or assigned
+  // when hoisted (a declaration would shadow the hoisted variable, and the
+  // code after the branch would read the hoisted one's 0).
   std::string unpack(int f, const std::vector<int> &outs, const std::string &array) {
     std::string code;
     for (size_t i = 0; i < outs.size(); ++i)
       if (used_[f].count(outs[i]))
-        code +=
-            "const double " + var_name(outs[i]) + " = " + array + "[" + std::to_string(i) + "];\n";
+        code += decl(f, outs[i]) + " = " + array + "[" + std::to_string(i) + "];\n";
     return code;
   }
 
