@@ -66,8 +66,9 @@ const char kUsage[] =
     "       sicm repl            interactive read-eval-print loop\n"
     "       sicm --version\n"
     "run, build, emit-c, emit-kernels and repl also take the limit flags\n"
-    "--max-steps, --max-memory, --max-expression-nodes, --max-recursion-depth and\n"
-    "--max-residual-size (sicm --help lists their defaults)\n";
+    "--max-steps, --max-memory, --max-expression-nodes, --max-recursion-depth,\n"
+    "--max-residual-size, and for build the unroll limits --max-unrolled-elements\n"
+    "and --max-unrolled-iterations (sicm --help lists their defaults)\n";
 
 struct Job {
   std::vector<std::string> args;
