@@ -36,15 +36,18 @@ LIBS      := -lflint -lgc -lgmp -lreadline -lsundials_cvode -lsundials_nvecseria
 # ---- sources, per component --------------------------------------------
 COMPILER_SRCS := $(wildcard compiler/*.cpp compiler/*/*.cpp)
 RUNTIME_SRCS  := $(wildcard runtime/src/*.c)
+# The runtime's C++17 files (Eigen): C functions implemented in C++.
+RUNTIME_CXX_SRCS := $(wildcard runtime/src/*.cpp)
 UNIT_SRCS     := $(wildcard tests/unit/*.cpp)
 
 # The standard library, embedded in the binary; listed in load order.
 STDLIB_FILES  := $(addprefix stdlib/,prelude.sicm local.sicm numerics.sicm lagrangian.sicm \
-                   rigid-body.sicm hamiltonian.sicm maps.sicm canonical.sicm lie.sicm)
+                   rigid-body.sicm hamiltonian.sicm maps.sicm stability.sicm canonical.sicm \
+                   lie.sicm)
 STDLIB_GEN    := $(BUILD)/gen/stdlib_embed.cpp
 
 COMPILER_OBJS := $(COMPILER_SRCS:%.cpp=$(BUILD)/%.o) $(BUILD)/gen/stdlib_embed.o
-RUNTIME_OBJS  := $(RUNTIME_SRCS:%.c=$(BUILD)/%.o)
+RUNTIME_OBJS  := $(RUNTIME_SRCS:%.c=$(BUILD)/%.o) $(RUNTIME_CXX_SRCS:%.cpp=$(BUILD)/%.o)
 UNIT_OBJS     := $(UNIT_SRCS:%.cpp=$(BUILD)/%.o)
 # Everything of the compiler except its entry point, for the unit tests.
 LIB_OBJS      := $(filter-out $(BUILD)/compiler/main.o,$(COMPILER_OBJS))
@@ -69,6 +72,16 @@ $(BUILD)/gen/stdlib_embed.o: $(STDLIB_GEN)
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+# The runtime's C++ files are C++17 (not the compiler's C++20) and see Eigen's
+# headers as system headers (no warnings from them). They define C functions
+# only, each in an archive member of its own, so the executables of `sicm
+# build` (linked by cc, without libstdc++) pull them in only if they call them.
+EIGEN_INC ?= /usr/include/eigen3
+RTCXXFLAGS := -std=c++17 $(OPT) -g $(WARN) $(SANFLAGS) -isystem $(EIGEN_INC)
+$(BUILD)/runtime/src/%.o: runtime/src/%.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CPPFLAGS) $(RTCXXFLAGS) -c $< -o $@
 
 $(RTLIB): $(RUNTIME_OBJS)
 	@mkdir -p $(dir $@)

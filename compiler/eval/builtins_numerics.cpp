@@ -1,5 +1,6 @@
 // Numerical primitives: definite-integral, minimize, nelder-mead,
-// multidimensional-minimize, find-root, bisect, state-advancer, evolve.
+// multidimensional-minimize, find-root, bisect, state-advancer, evolve,
+// eigenvalues.
 //
 // The runtime's numerical modules (runtime/include/sicm/*.h) work on C
 // functions of doubles. Here those functions are callbacks that apply a
@@ -981,6 +982,40 @@ Value P_bisect(Value *a, int n) {
   }
 }
 
+// ---- eigenvalues ----------------------------------------------------------------
+
+// (eigenvalues M): the eigenvalues of the square matrix M of real numbers, by
+// the runtime (Eigen), as a list ordered by decreasing modulus. sicm has no
+// non-real numbers, so a complex eigenvalue re + i im is the pair (re . im);
+// a real one is a flonum. Conjugate pairs come with im > 0 first.
+Value P_eigenvalues(Value *a, int) {
+  static const char who[] = "eigenvalues";
+  SrcLoc loc = current_call_loc();
+  if (!is_matrix(a[0])) wrong_type(a[0], 1, who);
+  Matrix *m = a[0].as<Matrix>();
+  if (m->rows != m->cols || m->rows == 0) wrong_type(a[0], 1, who);
+  size_t n = m->rows;
+  std::vector<double> entries(n * n), re(n), im(n);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      Value x = matrix_at(m, i, j);
+      if (!is_number(x))
+        numeric_error(loc, who,
+                      "the entry (" + std::to_string(i) + ", " + std::to_string(j) + ") is " +
+                          write_string(x) + ", not a real number");
+      entries[i * n + j] = to_double(x);
+    }
+  RuntimeErrorScope scope;
+  if (sicm_linalg_eigenvalues(n, entries.data(), re.data(), im.data()) != SICM_SUCCESS)
+    numeric_error(loc, who, reason_of(g_runtime_message));
+  Value result = Value::nil();
+  for (size_t k = n; k-- > 0;) {
+    Value z = im[k] == 0 ? Value::flonum(re[k]) : cons(Value::flonum(re[k]), Value::flonum(im[k]));
+    result = cons(z, result);
+  }
+  return result;
+}
+
 } // namespace
 
 const char *integrator_c_name(const std::string &name) {
@@ -1003,6 +1038,8 @@ void install_numerics_primitives() {
   define_primitive("bisect", 4, 5, P_bisect);
   define_primitive("state-advancer", 1, kVariadic, P_state_advancer);
   define_primitive("evolve", 1, kVariadic, P_evolve);
+  define_primitive("eigenvalues", 1, 1, P_eigenvalues);
+  define_primitive("matrix->eigenvalues", 1, 1, P_eigenvalues);
 }
 
 } // namespace sicm

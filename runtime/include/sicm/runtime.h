@@ -9,8 +9,10 @@
 #include <stddef.h>
 
 /* Numerical modules, one header each (documented there): status codes and
- * the error hook, ODE integrators, minimizers, root finders, quadrature. */
+ * the error hook, ODE integrators, minimizers, root finders, quadrature,
+ * dense linear algebra (eigenvalues, over Eigen). */
 #include "sicm/error.h"
+#include "sicm/linalg.h"
 #include "sicm/min.h"
 #include "sicm/ode.h"
 #include "sicm/quad.h"
