@@ -89,7 +89,8 @@ constexpr int kPoints = 3;
 constexpr double kRelTol = 1e-12;
 constexpr double kBoundFactor = 8;
 constexpr size_t kBatch = 256;      // kernels per C compilation
-constexpr int kCompileSeconds = 20; // per compilation (libFuzzer's -timeout is 30)
+constexpr int kCompileSeconds = 20; // per unit alone
+constexpr int kBatchSeconds = 120;  // per batch, then each unit alone
 constexpr size_t kMaxUnitBytes = 256 << 10;
 constexpr double kMaxSimplifiedDegree = 256; // see emit-3
 
@@ -100,7 +101,7 @@ size_t g_batch_size = kBatch;
 // What the checks did, printed at exit (for docs/reliability.md).
 struct Stats {
   unsigned long kernels = 0, simplified = 0, outputs = 0, compared = 0, by_bound = 0, skipped = 0,
-                compilations = 0, reused = 0, too_large = 0;
+                compilations = 0, reused = 0, too_large = 0, slow_batches = 0;
   double compile_seconds = 0;
 } g_stats;
 
@@ -109,9 +110,10 @@ void print_stats() {
   std::fprintf(stderr,
                "emit stats: %lu kernels (%lu simplified; %lu the same C as one before, not "
                "compiled again) in %lu compilations (%.1f s), %lu output values: %lu compared "
-               "(%lu within the error bound only), %lu skipped; %lu units too large to compile\n",
+               "(%lu within the error bound only), %lu skipped; %lu units too large to compile, "
+               "%lu batches compiled unit by unit\n",
                s.kernels, s.simplified, s.reused, s.compilations, s.compile_seconds, s.outputs,
-               s.compared, s.by_bound, s.skipped, s.too_large);
+               s.compared, s.by_bound, s.skipped, s.too_large, s.slow_batches);
 }
 gcvec<Symbol *> g_inputs;
 unsigned long g_serial = 0;
@@ -312,7 +314,8 @@ std::string slurp(const std::string &path) {
 // compiler's messages, or that it ran past kCompileSeconds and was killed).
 // -Wno-unused-variable: the emitter can leave a temporary unused (known bug:
 // fuzz/crashes-found/README.md, emit-2); remove it with the fix.
-std::string compile(const std::string &c_path, const std::string &so_path) {
+std::string compile(const std::string &c_path, const std::string &so_path,
+                    int seconds = kCompileSeconds) {
   std::string log = c_path + ".log";
   const char *argv[] = {"cc",
                         "-std=c11",
@@ -348,8 +351,7 @@ std::string compile(const std::string &c_path, const std::string &so_path) {
     pid_t r = waitpid(pid, &status, WNOHANG);
     if (r == pid) break;
     if (r < 0 && errno != EINTR) fuzz::fail("waitpid failed");
-    if (!killed &&
-        std::chrono::steady_clock::now() - start > std::chrono::seconds(kCompileSeconds)) {
+    if (!killed && std::chrono::steady_clock::now() - start > std::chrono::seconds(seconds)) {
       kill(-pid, SIGKILL);
       killed = true;
     }
@@ -362,8 +364,7 @@ std::string compile(const std::string &c_path, const std::string &so_path) {
   std::string out = slurp(log);
   unlink(log.c_str());
   if (killed)
-    return "the C compiler ran for more than " + std::to_string(kCompileSeconds) +
-           " s and was killed";
+    return "the C compiler ran for more than " + std::to_string(seconds) + " s and was killed";
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && out.empty()) return "";
   return out.empty() ? "cc failed without a message" : out;
 }
@@ -506,7 +507,7 @@ void check_batch() {
     line += static_cast<size_t>(std::count(k.src.begin(), k.src.end(), '\n'));
   }
   std::ofstream(c_path) << all;
-  std::string why = compile(c_path, so_path);
+  std::string why = compile(c_path, so_path, kBatchSeconds);
   if (!why.empty()) {
     // Charge the failure to one kernel and confirm it alone: a diagnostic
     // names its line; a compiler that ran too long, or a diagnostic
@@ -515,14 +516,36 @@ void check_batch() {
     if (const Pending *k = culprit_of(why, c_path)) suspects.push_back(k);
     for (const Pending &k : g_batch)
       if (k.same_as < 0 && (suspects.empty() || &k != suspects[0])) suspects.push_back(&k);
+    // If every unit compiles alone (the batch only took too long), each
+    // is checked alone too, and the batch is done.
+    std::vector<KernelFn> alone_fns(g_batch.size());
+    std::vector<void *> handles;
     for (const Pending *k : suspects) {
-      std::string one_c = stem + "-alone.c", one_so = stem + "-alone.so";
+      std::string one_c = stem + "-" + k->name + ".c", one_so = stem + "-" + k->name + ".so";
       std::ofstream(one_c) << k->src;
       std::string alone = compile(one_c, one_so);
       unlink(one_c.c_str());
-      unlink(one_so.c_str());
       if (!alone.empty())
         fail_for(*k, "the emitted C does not compile cleanly:\n" + alone + "\n" + k->src);
+      void *h = dlopen(one_so.c_str(), RTLD_NOW | RTLD_LOCAL);
+      unlink(one_so.c_str());
+      if (!h) fuzz::fail(std::string("dlopen: ") + dlerror());
+      handles.push_back(h);
+      alone_fns[static_cast<size_t>(k - g_batch.data())] =
+          reinterpret_cast<KernelFn>(dlsym(h, k->name.c_str()));
+    }
+    if (why.find("was killed") != std::string::npos) {
+      ++g_stats.slow_batches;
+      for (size_t i = 0; i < g_batch.size(); ++i) {
+        const Pending &k = g_batch[i];
+        KernelFn fn = alone_fns[k.same_as >= 0 ? static_cast<size_t>(k.same_as) : i];
+        if (!fn) fail_for(k, "the kernel's symbol is missing");
+        check_kernel(k, fn);
+      }
+      for (void *h : handles)
+        dlclose(h);
+      unlink(c_path.c_str());
+      return;
     }
     fail_for(g_batch.back(),
              "the batch of " + std::to_string(g_batch.size()) + " kernels (" + c_path +
