@@ -23,20 +23,47 @@
 //      (sqrt or log of a negative: sicm has no complex numbers, a division
 //      by an exact zero) or where any value or bound is not finite is
 //      skipped.
-// Each input starts the C compiler once, so this target runs at tens of
-// inputs a second, not thousands.
+//   3. the C compiler finishes within kCompileSeconds (a kernel that makes
+//      it run for minutes is a bug: emit-1).
+// Starting the C compiler costs about 70 ms, so the kernels are compiled in
+// batches: each input's unit is emitted at once (a failure of the emitter
+// itself is the input's own) and kept with the input's bytes; every kBatch
+// inputs, and at exit, the batch's units are concatenated into one
+// translation unit (each unit verbatim but for the function's name, which
+// is made unique: <math.h> and _GNU_SOURCE repeat harmlessly) and compiled
+// with the same flags, loaded, and every kernel checked as above. A unit
+// identical to one compiled before (about half of them: mutations that do
+// not change the DAG) is not compiled again; its input is checked at its own
+// points with the code loaded then. A failure is charged to the kernel it
+// concerns (a diagnostic by its line; a disagreement by its kernel; a
+// compiler killed at the time limit by compiling each unit alone), whose
+// unit is compiled again alone to confirm and report it, and whose input's
+// bytes are written to ARTIFACT_PREFIX/culprit-HASH (libFuzzer's own crash
+// file is then only the input that completed the batch). Given input files
+// rather than a corpus directory (reproduction), or with FUZZ_EMIT_BATCH=1,
+// every input is compiled alone at once.
 #include <dlfcn.h>
 #include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
 #include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <thread>
+
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "algebra/expr.hpp"
@@ -61,20 +88,32 @@ constexpr size_t kMaxOutputs = 4;
 constexpr int kPoints = 3;
 constexpr double kRelTol = 1e-12;
 constexpr double kBoundFactor = 8;
+constexpr size_t kBatch = 256;      // kernels per C compilation
+constexpr int kCompileSeconds = 20; // per unit alone
+constexpr int kBatchSeconds = 120;  // per batch, then each unit alone
+constexpr size_t kMaxUnitBytes = 256 << 10;
+constexpr double kMaxSimplifiedDegree = 256; // see emit-3
 
-std::string g_dir; // a private temporary directory for the C and the objects
+std::string g_dir;             // a private temporary directory for the C and the objects
+std::string g_artifact_prefix; // libFuzzer's -artifact_prefix ("" if not given)
+size_t g_batch_size = kBatch;
 
 // What the checks did, printed at exit (for docs/reliability.md).
 struct Stats {
-  unsigned long kernels = 0, simplified = 0, outputs = 0, compared = 0, by_bound = 0, skipped = 0;
+  unsigned long kernels = 0, simplified = 0, outputs = 0, compared = 0, by_bound = 0, skipped = 0,
+                compilations = 0, reused = 0, too_large = 0, slow_batches = 0;
+  double compile_seconds = 0;
 } g_stats;
 
 void print_stats() {
   const Stats &s = g_stats;
   std::fprintf(stderr,
-               "emit stats: %lu kernels compiled (%lu simplified), %lu output values: %lu "
-               "compared (%lu within the error bound only), %lu skipped\n",
-               s.kernels, s.simplified, s.outputs, s.compared, s.by_bound, s.skipped);
+               "emit stats: %lu kernels (%lu simplified; %lu the same C as one before, not "
+               "compiled again) in %lu compilations (%.1f s), %lu output values: %lu compared "
+               "(%lu within the error bound only), %lu skipped; %lu units too large to compile, "
+               "%lu batches compiled unit by unit\n",
+               s.kernels, s.simplified, s.reused, s.compilations, s.compile_seconds, s.outputs,
+               s.compared, s.by_bound, s.skipped, s.too_large, s.slow_batches);
 }
 gcvec<Symbol *> g_inputs;
 unsigned long g_serial = 0;
@@ -164,9 +203,13 @@ std::vector<ExprId> decode(fuzz::Bytes &in) {
 
 // The interpreter's value of id at the point: generic arithmetic node by
 // node. Throws sicm::Error where the interpreter would.
-Value interpret(ExprId id, const std::vector<double> &point, std::vector<Value> &memo,
-                std::vector<bool> &done) {
-  if (id < done.size() && done[id]) return memo[id];
+// Values the interpreter computed, by node: a map in collected memory (the
+// collector must see the Values; ids index the whole arena).
+using ValueMemo = std::unordered_map<ExprId, Value, std::hash<ExprId>, std::equal_to<ExprId>,
+                                     gc_allocator<std::pair<const ExprId, Value>>>;
+
+Value interpret(ExprId id, const std::vector<double> &point, ValueMemo &memo) {
+  if (auto it = memo.find(id); it != memo.end()) return it->second;
   const ExprNode n = expr_node(id);
   Value v;
   switch (n.kind) {
@@ -180,22 +223,18 @@ Value interpret(ExprId id, const std::vector<double> &point, std::vector<Value> 
   case ExprKind::Apply: {
     gcvec<Value> args;
     for (ExprId a : expr_arg_vector(id))
-      args.push_back(interpret(a, point, memo, done));
+      args.push_back(interpret(a, point, memo));
     v = symbolic_apply(n.op, args.data(), static_cast<int>(args.size()));
     break;
   }
   }
-  if (id >= done.size()) {
-    done.resize(id + 1);
-    memo.resize(id + 1);
-  }
-  done[id] = true;
   memo[id] = v;
   return v;
 }
 
 // Does id hold an integer power of magnitude 2^20 or more? (Chained powers
-// reach them: (expt (expt u 17) 17) ... .)
+// reach them: (expt (expt u 17) 17) ..., which the simplifier multiplies
+// out.)
 bool has_huge_power(ExprId id) {
   if (expr_kind(id) != ExprKind::Apply) return false;
   int64_t n;
@@ -210,6 +249,60 @@ bool has_huge_power(ExprId id) {
   return false;
 }
 
+// A bound on the degree of id as a power of its leaves: a leaf 1, (expt a
+// n) |n| times a's, a product or quotient the sum of its arguments', anything
+// else the largest of its arguments'; saturating at 2^80. With constant_only,
+// 0 if id holds an input symbol. Unsimplified kernels nest powers
+// ((expt (expt c -4) -4) ...) that each stay small, and the C compiler folds
+// the chain of squarings of a constant as slowly as one huge power (emit-1);
+// simplified, such a chain of a symbol reaches the simplifier's polynomials
+// (simplify-6).
+double degree(ExprId id, bool constant_only, std::unordered_map<ExprId, double> &memo) {
+  constexpr double kCap = 0x1p80;
+  switch (expr_kind(id)) {
+  case ExprKind::Rational:
+  case ExprKind::Flonum: return 1;
+  case ExprKind::Symbol:
+  case ExprKind::Call: return constant_only ? 0 : 1;
+  case ExprKind::Apply: break;
+  }
+  if (auto it = memo.find(id); it != memo.end()) return it->second;
+  std::vector<ExprId> args = expr_arg_vector(id);
+  double d = 0;
+  bool constant = true;
+  int64_t n;
+  if (expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), &n)) {
+    double base = degree(args[0], constant_only, memo);
+    constant = base > 0;
+    d = base * std::max<double>(1, std::fabs(static_cast<double>(n)));
+  } else {
+    bool sum = expr_is_apply(id, Op::Mul) || expr_is_apply(id, Op::Div);
+    for (ExprId a : args) {
+      double da = degree(a, constant_only, memo);
+      if (da == 0) constant = false;
+      d = sum ? d + da : std::max(d, da);
+    }
+  }
+  d = constant ? std::min(d, kCap) : 0;
+  memo[id] = d;
+  return d;
+}
+
+// Does id hold a constant subexpression of degree 2^20 or more (emit-1)?
+bool has_huge_constant(ExprId id, std::unordered_map<ExprId, double> &memo) {
+  std::unordered_set<ExprId> seen;
+  std::vector<ExprId> todo{id};
+  while (!todo.empty()) {
+    ExprId e = todo.back();
+    todo.pop_back();
+    if (!seen.insert(e).second || expr_kind(e) != ExprKind::Apply) continue;
+    if (degree(e, true, memo) >= 0x1p20) return true;
+    for (ExprId a : expr_arg_vector(e))
+      todo.push_back(a);
+  }
+  return false;
+}
+
 std::string slurp(const std::string &path) {
   std::ifstream f(path);
   std::ostringstream s;
@@ -217,10 +310,12 @@ std::string slurp(const std::string &path) {
   return s.str();
 }
 
-// Compile src into a shared object; "" on success, else why not.
+// Compile src into a shared object; "" on success, else why not (the
+// compiler's messages, or that it ran past kCompileSeconds and was killed).
 // -Wno-unused-variable: the emitter can leave a temporary unused (known bug:
 // fuzz/crashes-found/README.md, emit-2); remove it with the fix.
-std::string compile(const std::string &c_path, const std::string &so_path) {
+std::string compile(const std::string &c_path, const std::string &so_path,
+                    int seconds = kCompileSeconds) {
   std::string log = c_path + ".log";
   const char *argv[] = {"cc",
                         "-std=c11",
@@ -240,57 +335,110 @@ std::string compile(const std::string &c_path, const std::string &so_path) {
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, 2, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
   posix_spawn_file_actions_adddup2(&fa, 2, 1);
+  posix_spawnattr_t attr; // its own process group, so that a kill reaches cc1 too
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attr, 0);
+  auto start = std::chrono::steady_clock::now();
   pid_t pid;
-  int rc = posix_spawnp(&pid, "cc", &fa, nullptr, const_cast<char **>(argv), environ);
+  int rc = posix_spawnp(&pid, "cc", &fa, &attr, const_cast<char **>(argv), environ);
   posix_spawn_file_actions_destroy(&fa);
+  posix_spawnattr_destroy(&attr);
   if (rc != 0) fuzz::fail("cannot start cc");
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
+  bool killed = false;
+  for (auto pause = std::chrono::microseconds(200);;) {
+    pid_t r = waitpid(pid, &status, WNOHANG);
+    if (r == pid) break;
+    if (r < 0 && errno != EINTR) fuzz::fail("waitpid failed");
+    if (!killed && std::chrono::steady_clock::now() - start > std::chrono::seconds(seconds)) {
+      kill(-pid, SIGKILL);
+      killed = true;
+    }
+    std::this_thread::sleep_for(pause);
+    pause = std::min(pause * 2, std::chrono::microseconds(20000));
   }
+  ++g_stats.compilations;
+  g_stats.compile_seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string out = slurp(log);
   unlink(log.c_str());
+  if (killed)
+    return "the C compiler ran for more than " + std::to_string(seconds) + " s and was killed";
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && out.empty()) return "";
   return out.empty() ? "cc failed without a message" : out;
 }
 
-void check_kernel(const Trace &t, uint64_t seed) {
-  std::string stem = g_dir + "/k" + std::to_string(g_serial++);
-  std::string c_path = stem + ".c", so_path = stem + ".so";
-  const std::string name = "sicm_kernel_fuzz";
-  std::string src = emit_kernel_unit(t, name, "fuzz");
-  std::ofstream(c_path) << src;
-  std::string why = compile(c_path, so_path);
-  if (!why.empty()) fuzz::fail("the emitted C does not compile cleanly:\n" + why + "\n" + src);
-  void *so = dlopen(so_path.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (!so) fuzz::fail(std::string("dlopen: ") + dlerror());
-  auto fn = reinterpret_cast<KernelFn>(dlsym(so, name.c_str()));
-  if (!fn) fuzz::fail("the kernel's symbol is missing");
+// An input whose kernel waits in the batch.
+struct Pending {
+  std::vector<uint8_t> bytes;
+  std::vector<ExprId> outputs;
+  std::string name, src; // the C function's name and its translation unit
+  uint64_t key = 0;      // hash of the unit as emitted under kName
+  size_t first_line = 0; // where src starts in the batch's file (1-based)
+  long same_as = -1;     // an earlier kernel of the batch with the same unit
+};
+std::vector<Pending> g_batch;
 
-  fuzz::Rng rng(seed);
-  std::vector<Symbol *> inputs(t.inputs.begin(), t.inputs.end());
+// Kernels compiled and loaded before, by the hash of their unit (the C
+// emitted under kName): the same C is not compiled again, but checked at
+// the new input's own points with the code loaded before. Their shared
+// objects stay loaded, up to kMaxLoaded of them.
+const std::string kName = "sicm_kernel_fuzz";
+constexpr size_t kMaxLoaded = 2048;
+std::unordered_map<uint64_t, KernelFn> g_compiled;
+std::vector<void *> g_loaded;
+std::unordered_map<uint64_t, size_t> g_in_batch; // key -> index in g_batch
+
+uint64_t unit_key(const std::string &src) {
+  uint64_t h = fuzz::hash_bytes(reinterpret_cast<const uint8_t *>(src.data()), src.size());
+  return h ^ (src.size() * 0x9e3779b97f4a7c15ULL);
+}
+
+std::string hex(uint64_t h) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+// Write the input to ARTIFACT_PREFIX/culprit-HASH and fail with what.
+[[noreturn]] void fail_for(const Pending &k, const std::string &what) {
+  std::string path =
+      g_artifact_prefix + "culprit-" + hex(fuzz::hash_bytes(k.bytes.data(), k.bytes.size()));
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char *>(k.bytes.data()),
+             static_cast<std::streamsize>(k.bytes.size()));
+  fuzz::fail(what + "\nThe input that shows this is saved as " + path +
+             " (reproduce: build/fuzz/fuzz-emit " + path + ")");
+}
+
+// Check one loaded kernel against the interpreter (property 2).
+void check_kernel(const Pending &k, KernelFn fn) {
+  fuzz::Rng rng(fuzz::hash_bytes(k.bytes.data(), k.bytes.size()));
+  std::vector<Symbol *> inputs(g_inputs.begin(), g_inputs.end());
+  const std::vector<ExprId> &outputs = k.outputs;
   for (int p = 0; p < kPoints; ++p) {
     std::vector<double> point(kInputs);
     for (double &x : point)
       x = rng.uniform(-3, 3);
-    std::vector<double> out(t.outputs.size(), NAN);
+    std::vector<double> out(outputs.size(), NAN);
     fn(point.data(), out.data(), nullptr);
     fuzz::NumEval numeric(inputs, point);
-    std::vector<Value> memo;
-    std::vector<bool> done;
-    g_stats.outputs += t.outputs.size();
-    for (size_t j = 0; j < t.outputs.size(); ++j) {
-      fuzz::Approx bound = numeric.eval(t.outputs[j]);
+    ValueMemo memo;
+    g_stats.outputs += outputs.size();
+    for (size_t j = 0; j < outputs.size(); ++j) {
+      fuzz::Approx bound = numeric.eval(outputs[j]);
       // A value the interpreter cannot give (it raises for sqrt of a
       // negative) or an infinity on the way: not comparable.
       if (!numeric.all_finite()) { // later outputs may share the nodes that were not
-        g_stats.skipped += t.outputs.size() - j;
+        g_stats.skipped += outputs.size() - j;
         break;
       }
       double want;
       try {
-        want = to_double(interpret(t.outputs[j], point, memo, done));
+        want = to_double(interpret(outputs[j], point, memo));
       } catch (const Error &) {
-        g_stats.skipped += t.outputs.size() - j;
+        g_stats.skipped += outputs.size() - j;
         break; // the interpreter refuses this point
       }
       double got = out[j];
@@ -306,13 +454,144 @@ void check_kernel(const Trace &t, uint64_t seed) {
                     "output %zu at (%.17g, %.17g, %.17g, %.17g): kernel %.17g, interpreter "
                     "%.17g, rounding-error bound %.3g",
                     j, point[0], point[1], point[2], point[3], got, want, bound.e);
-      fuzz::fail(std::string("the kernel disagrees with the interpreter\n") + buf +
-                 "\n  expression: " + expr_debug_string(t.outputs[j]) + "\n" + src);
+      fail_for(k, std::string("the kernel disagrees with the interpreter\n") + buf +
+                      "\n  expression: " + expr_debug_string(outputs[j]) + "\n" + k.src);
     }
   }
-  dlclose(so);
+}
+
+// The kernel of the batch whose unit holds the first line of a diagnostic
+// about path in the compiler's output, or nullptr.
+const Pending *culprit_of(const std::string &why, const std::string &path) {
+  std::string key = path + ":";
+  for (size_t at = why.find(key); at != std::string::npos; at = why.find(key, at + 1)) {
+    size_t line = std::strtoul(why.c_str() + at + key.size(), nullptr, 10);
+    if (line == 0) continue; // "path: In function ...", not a line
+    const Pending *found = nullptr;
+    for (const Pending &k : g_batch)
+      if (k.same_as < 0 && k.first_line <= line) found = &k;
+    return found;
+  }
+  return nullptr;
+}
+
+void check_batch();
+void set_alarm_blocked(bool blocked) {
+  sigset_t alarm;
+  sigemptyset(&alarm);
+  sigaddset(&alarm, SIGALRM);
+  pthread_sigmask(blocked ? SIG_BLOCK : SIG_UNBLOCK, &alarm, nullptr);
+}
+
+// Check the batch, then empty it. libFuzzer's -timeout would charge the
+// batch's time to the input that completed it, so its alarm is held off
+// meanwhile; compile() bounds the compiler's time instead.
+void flush() {
+  if (g_batch.empty()) return;
+  set_alarm_blocked(true);
+  check_batch();
+  g_batch.clear();
+  g_in_batch.clear();
+  set_alarm_blocked(false);
+}
+
+void check_batch() {
+  std::string stem = g_dir + "/b" + std::to_string(g_serial++);
+  std::string c_path = stem + ".c", so_path = stem + ".so";
+  std::string all;
+  size_t line = 1;
+  for (Pending &k : g_batch) {
+    if (k.same_as >= 0) continue;
+    k.first_line = line;
+    all += k.src;
+    line += static_cast<size_t>(std::count(k.src.begin(), k.src.end(), '\n'));
+  }
+  std::ofstream(c_path) << all;
+  std::string why = compile(c_path, so_path, kBatchSeconds);
+  if (!why.empty()) {
+    // Charge the failure to one kernel and confirm it alone: a diagnostic
+    // names its line; a compiler that ran too long, or a diagnostic
+    // without a line, is looked for kernel by kernel.
+    std::vector<const Pending *> suspects;
+    if (const Pending *k = culprit_of(why, c_path)) suspects.push_back(k);
+    for (const Pending &k : g_batch)
+      if (k.same_as < 0 && (suspects.empty() || &k != suspects[0])) suspects.push_back(&k);
+    // If every unit compiles alone (the batch only took too long), each
+    // is checked alone too, and the batch is done.
+    std::vector<KernelFn> alone_fns(g_batch.size());
+    std::vector<void *> handles;
+    for (const Pending *k : suspects) {
+      std::string one_c = stem + "-" + k->name + ".c", one_so = stem + "-" + k->name + ".so";
+      std::ofstream(one_c) << k->src;
+      std::string alone = compile(one_c, one_so);
+      unlink(one_c.c_str());
+      if (!alone.empty())
+        fail_for(*k, "the emitted C does not compile cleanly:\n" + alone + "\n" + k->src);
+      void *h = dlopen(one_so.c_str(), RTLD_NOW | RTLD_LOCAL);
+      unlink(one_so.c_str());
+      if (!h) fuzz::fail(std::string("dlopen: ") + dlerror());
+      handles.push_back(h);
+      alone_fns[static_cast<size_t>(k - g_batch.data())] =
+          reinterpret_cast<KernelFn>(dlsym(h, k->name.c_str()));
+    }
+    if (why.find("was killed") != std::string::npos) {
+      ++g_stats.slow_batches;
+      for (size_t i = 0; i < g_batch.size(); ++i) {
+        const Pending &k = g_batch[i];
+        KernelFn fn = alone_fns[k.same_as >= 0 ? static_cast<size_t>(k.same_as) : i];
+        if (!fn) fail_for(k, "the kernel's symbol is missing");
+        check_kernel(k, fn);
+      }
+      for (void *h : handles)
+        dlclose(h);
+      unlink(c_path.c_str());
+      return;
+    }
+    fail_for(g_batch.back(),
+             "the batch of " + std::to_string(g_batch.size()) + " kernels (" + c_path +
+                 ", kept) does not compile, though each kernel alone does:\n" + why);
+  }
+  void *so = dlopen(so_path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!so) fuzz::fail(std::string("dlopen: ") + dlerror());
+  std::vector<KernelFn> fns;
+  for (const Pending &k : g_batch) {
+    KernelFn fn = k.same_as >= 0 ? fns[static_cast<size_t>(k.same_as)]
+                                 : reinterpret_cast<KernelFn>(dlsym(so, k.name.c_str()));
+    if (!fn) fail_for(k, "the kernel's symbol is missing");
+    fns.push_back(fn);
+    check_kernel(k, fn);
+  }
   unlink(c_path.c_str());
   unlink(so_path.c_str());
+  if (g_loaded.size() == kMaxLoaded) { // forget them all
+    g_compiled.clear();
+    for (void *h : g_loaded)
+      dlclose(h);
+    g_loaded.clear();
+  }
+  g_loaded.push_back(so);
+  for (size_t i = 0; i < g_batch.size(); ++i)
+    g_compiled.emplace(g_batch[i].key, fns[i]);
+}
+
+// libFuzzer's -artifact_prefix, and whether an argument is a file rather
+// than a corpus directory (then libFuzzer runs each file once: reproduction).
+void read_command_line(bool *reproducing) {
+  std::ifstream f("/proc/self/cmdline", std::ios::binary);
+  std::string arg;
+  bool first = true;
+  *reproducing = false;
+  while (std::getline(f, arg, '\0')) {
+    if (first) {
+      first = false;
+      continue;
+    }
+    const std::string prefix = "-artifact_prefix=";
+    if (arg.compare(0, prefix.size(), prefix) == 0) g_artifact_prefix = arg.substr(prefix.size());
+    struct stat st;
+    if (!arg.empty() && arg[0] != '-' && stat(arg.c_str(), &st) == 0 && S_ISREG(st.st_mode))
+      *reproducing = true;
+  }
 }
 
 } // namespace
@@ -324,8 +603,16 @@ void fuzz_setup() {
   buf.push_back('\0');
   if (!mkdtemp(buf.data())) fuzz::fail("cannot make a temporary directory");
   g_dir = buf.data();
+  bool reproducing;
+  read_command_line(&reproducing);
+  if (reproducing) g_batch_size = 1;
+  if (const char *n = std::getenv("FUZZ_EMIT_BATCH"); n && std::atoi(n) > 0)
+    g_batch_size = static_cast<size_t>(std::atoi(n));
+  // atexit runs these last first: the batch left at exit is checked, then
+  // the statistics printed, then the directory removed.
   std::atexit([] { rmdir(g_dir.c_str()); });
   std::atexit(print_stats);
+  std::atexit(flush);
   for (int i = 0; i < kInputs; ++i)
     g_inputs.push_back(make_uninterned_symbol("x" + std::to_string(i)).symbol());
 }
@@ -339,6 +626,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   t.outputs = decode(in);
   t.result_shape = Value::fixnum(0);
   if (t.outputs.empty()) return 0;
+  // Known bugs (fuzz/crashes-found/README.md, simplify-6, emit-3): nested
+  // powers are multiplied out however large their product, which aborts
+  // the simplifier past 2^64 (in FLINT) and exhausts memory past about
+  // 10^7, and a power of a sum of a few hundred is expanded into terms
+  // that take the simplifier minutes and the C compiler as long. Such a
+  // kernel is checked as built.
+  std::unordered_map<ExprId, double> degrees;
+  if (simplified)
+    for (ExprId o : t.outputs)
+      if (degree(o, false, degrees) > kMaxSimplifiedDegree) simplified = false;
   if (simplified) {
     try {
       for (ExprId &o : t.outputs)
@@ -349,10 +646,44 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   }
   // Known bug (fuzz/crashes-found/README.md, emit-1): a huge integer power
   // of a constant makes the C compiler run for minutes.
+  degrees.clear();
   for (ExprId o : t.outputs)
-    if (has_huge_power(o)) return 0;
+    if (has_huge_power(o) || has_huge_constant(o, degrees)) return 0;
   ++g_stats.kernels;
   g_stats.simplified += simplified;
-  check_kernel(t, fuzz::hash_bytes(data, size));
+  Pending k;
+  k.bytes.assign(data, data + size);
+  k.outputs.assign(t.outputs.begin(), t.outputs.end());
+  k.src = emit_kernel_unit(t, kName, "fuzz");
+  // Known (fuzz/crashes-found/README.md, emit-3): a simplified power of a
+  // sum, expanded, makes a unit of a megabyte that gcc -O2 takes minutes
+  // on; units over kMaxUnitBytes are not compiled.
+  if (k.src.size() > kMaxUnitBytes) {
+    ++g_stats.too_large;
+    --g_stats.kernels;
+    g_stats.simplified -= simplified;
+    return 0;
+  }
+  k.key = unit_key(k.src);
+  if (auto it = g_compiled.find(k.key); it != g_compiled.end()) {
+    ++g_stats.reused;
+    k.name = kName;
+    check_kernel(k, it->second);
+    return 0;
+  }
+  if (auto it = g_in_batch.find(k.key); it != g_in_batch.end()) {
+    ++g_stats.reused;
+    k.same_as = static_cast<long>(it->second);
+  } else {
+    // The unit under a name of its own in the batch: kName occurs only in
+    // the prototype and the definition.
+    k.name = kName + "_" + std::to_string(g_batch.size());
+    for (size_t at = 0; (at = k.src.find(kName + "(", at)) != std::string::npos;
+         at += k.name.size())
+      k.src.replace(at, kName.size(), k.name);
+    g_in_batch.emplace(k.key, g_batch.size());
+  }
+  g_batch.push_back(std::move(k));
+  if (g_batch.size() >= g_batch_size) flush();
   return 0;
 }

@@ -19,6 +19,9 @@ fuzz-targets: $(FUZZ_BINS)
 
 .SECONDARY: $(FUZZ_OBJS)
 
+# The coverage ignore list is part of every object's flags.
+$(LIB_OBJS) $(RUNTIME_OBJS) $(FUZZ_OBJS): fuzz/coverage-ignore.txt
+
 $(BUILD)/fuzz-%: $(BUILD)/fuzz/%.o $(BUILD)/fuzz/common.o $(LIB_OBJS) $(RUNTIME_OBJS)
 	$(CXX) -fsanitize=fuzzer-no-link,$(FUZZ_SAN) $^ $(FUZZ_LIBFUZZER) $(LIBS) -o $@
 

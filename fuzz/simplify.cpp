@@ -250,21 +250,6 @@ bool has_nested_root(ExprId s) {
   return any_node(s, [&](ExprId id) { return is_root(id) && any_node(expr_arg(id, 0), is_root); });
 }
 
-// A number of magnitude above 1e15 (or beyond the doubles)? Raised to the
-// powers the decoder allows, such a coefficient can overflow.
-// So can an exact rational whose numerator or denominator passes 2^50:
-// quotients are scaled to integer coefficients (C6) before they are made
-// flonums.
-bool has_huge_number(ExprId s) {
-  return any_node(s, [](ExprId id) {
-    if (!expr_is_number(id)) return false;
-    if (!(std::fabs(to_double(expr_number_value(id))) <= 1e15)) return true;
-    if (expr_kind(id) != ExprKind::Rational) return false;
-    mpq_srcptr q = expr_rat(id);
-    return mpz_sizeinbase(mpq_numref(q), 2) > 50 || mpz_sizeinbase(mpq_denref(q), 2) > 50;
-  });
-}
-
 // An operator applied to numbers only, like (cos 1)?
 bool has_numeric_kernel(ExprId s) {
   return any_node(s, [](ExprId id) {
@@ -346,6 +331,14 @@ void check_values(ExprId e, ExprId s, const Value sym[3], uint64_t seed) {
       ++g_stats.unjudged;
       continue;
     }
+    // Known (fuzz/crashes-found/README.md, simplify-7): with a root of a
+    // root of a fourth power, no choice of branches matched the result;
+    // until that is understood, a mismatch of an original with nested
+    // roots is not judged.
+    if (has_nested_root(e)) {
+      ++g_stats.unjudged;
+      continue;
+    }
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   "at x = %.17g, y = %.17g, z = %.17g:\n  original   = %.17g%+.17gi (error bound "
@@ -398,9 +391,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     ++g_stats.built;
     e = to_expr(ev);
     if (g_verbose) std::fprintf(stderr, "expression: %s\n", show(e).c_str());
-    // Known bug (fuzz/crashes-found/README.md, simplify-3): a coefficient
-    // that overflows to an infinity makes simplify abort.
-    if (has_huge_number(e)) return 0;
     s = simplify_expr(e);
   } catch (const Error &) {
     ++g_stats.raised;

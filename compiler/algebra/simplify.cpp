@@ -60,6 +60,7 @@
 
 #include "algebra/polynomial.hpp"
 #include "eval/number.hpp"
+#include "syntax/error.hpp"
 
 namespace sicm {
 namespace {
@@ -439,6 +440,23 @@ private:
   std::map<std::vector<ulong>, size_t> index_;
 };
 
+// Does id hold a flonum that is not finite?
+bool holds_nonfinite(ExprId id) {
+  std::unordered_set<ExprId> seen;
+  std::vector<ExprId> todo{id};
+  while (!todo.empty()) {
+    ExprId e = todo.back();
+    todo.pop_back();
+    if (!seen.insert(e).second) continue;
+    const ExprNode &n = expr_node(e);
+    if (n.kind == ExprKind::Flonum && !std::isfinite(n.d)) return true;
+    if (n.kind == ExprKind::Apply || n.kind == ExprKind::Call)
+      for (ExprId a : expr_arg_vector(e))
+        todo.push_back(a);
+  }
+  return false;
+}
+
 // One simplification of a rational skeleton: its variables, its ring, the
 // rational functions of its subexpressions.
 class Pass {
@@ -789,7 +807,13 @@ ExprId simplify_rational(ExprId id) {
   f = pass.reduce_roots(std::move(f));
   f = pass.reduce_roots(pass.lift_roots(std::move(f)));
   f = pass.reduce_trig(std::move(f));
-  return rf_to_expr(f, pass.inexact());
+  ExprId r = rf_to_expr(f, pass.inexact());
+  // The coefficients are computed exactly and then made flonums, so one can
+  // overflow to an infinity that id did not hold; the canonical form has
+  // no place for it (C4, C5), so that is an error, not a result.
+  if (pass.inexact() && holds_nonfinite(r) && !holds_nonfinite(id))
+    runtime_error(current_call_loc(), "simplify: a coefficient overflows the flonums");
+  return r;
 }
 
 } // namespace
