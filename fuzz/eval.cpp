@@ -18,7 +18,6 @@
 //     state-advancer through their kernels), write files (plots), end the
 //     process (exit), or depend on the clock or a random state (runtime,
 //     real-time, random), which would make runs irreproducible;
-//   - assoc is guarded against a known crash (eval-1; guarded_assoc below);
 //   - output is discarded (set_output_hook), and SICM_INTERPRET=1 keeps the
 //     numerical primitives from compiling kernels.
 // Between inputs the global bindings are restored to what they were after
@@ -68,19 +67,6 @@ const char *const kExcluded[] = {
 
 Value excluded_primitive(Value *, int) {
   runtime_error(current_call_loc(), "this primitive is excluded when fuzzing the evaluator");
-}
-
-// Known bug (fuzz/crashes-found/README.md, eval-1): assoc with a third
-// argument takes the car of every element of the list without checking
-// that it is a pair, and crashes on (assoc 'b '(1) equal?). Until it is
-// fixed, assoc is rebound to this, which raises the error assoc's two-
-// argument form raises, then calls the original.
-Value g_assoc;
-Value guarded_assoc(Value *a, int n) {
-  if (n == 3)
-    for (Value p = a[1]; is_pair(p); p = cdr(p))
-      if (!is_pair(car(p))) wrong_type(a[1], 2, "assoc");
-  return apply_procedure(g_assoc, a, n);
 }
 
 void discard_output(std::string_view) {}
@@ -200,8 +186,6 @@ void fuzz_setup() {
   init_interpreter();
   for (const char *name : kExcluded)
     define_primitive(name, 0, kVariadic, excluded_primitive);
-  g_assoc = intern("assoc").symbol()->global;
-  define_primitive("assoc", 2, 3, guarded_assoc);
   set_output_hook(discard_output);
   // Plots are excluded; should one slip through, it lands in a scratch
   // directory, not in the working directory.

@@ -241,11 +241,17 @@ Value P_assq(Value *a, int) {
 Value P_assv(Value *a, int) {
   return assoc_generic<eqv>(a[0], a[1], "assv");
 }
+// (assoc x alist [same?]): with a third argument, entries are compared by
+// calling it; the alist is checked as for two arguments (an entry that is
+// not a pair is MIT's wrong-type error, not a crash).
 Value P_assoc(Value *a, int n) {
   if (n < 3) return assoc_generic<equal>(a[0], a[1], "assoc");
+  if (list_length(a[1]) < 0) wrong_type(a[1], 2, "assoc");
   for (Value p = a[1]; is_pair(p); p = cdr(p)) {
-    Value args[2] = {a[0], car(car(p))};
-    if (apply_procedure(a[2], args, 2).truthy()) return car(p);
+    Value entry = car(p);
+    if (!is_pair(entry)) wrong_type(a[1], 2, "assoc");
+    Value args[2] = {a[0], car(entry)};
+    if (apply_procedure(a[2], args, 2).truthy()) return entry;
   }
   return Value::boolean(false);
 }
