@@ -256,7 +256,7 @@ bool has_huge_power(ExprId id) {
 // ((expt (expt c -4) -4) ...) that each stay small, and the C compiler folds
 // the chain of squarings of a constant as slowly as one huge power (emit-1);
 // simplified, such a chain of a symbol reaches the simplifier's polynomials
-// (simplify-6).
+// (and past its degree limit raises, simplify-6).
 double degree(ExprId id, bool constant_only, std::unordered_map<ExprId, double> &memo) {
   constexpr double kCap = 0x1p80;
   switch (expr_kind(id)) {
@@ -626,12 +626,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   t.outputs = decode(in);
   t.result_shape = Value::fixnum(0);
   if (t.outputs.empty()) return 0;
-  // Known bugs (fuzz/crashes-found/README.md, simplify-6, emit-3): nested
-  // powers are multiplied out however large their product, which aborts
-  // the simplifier past 2^64 (in FLINT) and exhausts memory past about
-  // 10^7, and a power of a sum of a few hundred is expanded into terms
-  // that take the simplifier minutes and the C compiler as long. Such a
-  // kernel is checked as built.
+  // Known slowness (fuzz/crashes-found/README.md, emit-3): a power of a
+  // sum of a few hundred is expanded into terms that take the simplifier
+  // minutes and the C compiler as long (nested powers past the simplifier's
+  // degree limit are an error since simplify-6 was fixed). Such a kernel is
+  // checked as built.
   std::unordered_map<ExprId, double> degrees;
   if (simplified)
     for (ExprId o : t.outputs)

@@ -12,10 +12,13 @@
 #include <flint/fmpq_mpoly_factor.h>
 
 #include <algorithm>
+#include <climits>
 #include <cstdlib>
 #include <new>
+#include <string>
 
 #include "eval/number.hpp"
+#include "syntax/error.hpp"
 
 namespace sicm {
 
@@ -240,6 +243,30 @@ RatFun rf_div(const RatFun &a, const RatFun &b) {
   return rf_mul(a, rf_inv(b));
 }
 
+namespace {
+
+// Total degree of p, or LONG_MAX when it does not fit a word.
+long total_degree(const Poly &p) {
+  if (!fmpq_mpoly_total_degree_fits_si(p.get(), p.ctx())) return LONG_MAX;
+  return static_cast<long>(fmpq_mpoly_total_degree_si(p.get(), p.ctx()));
+}
+
+// Nested powers multiply degrees: (expt (expt x 12) 12) eighteen deep has
+// degree 12^18, each power being below kMaxExpandedPower. Expanded, such a
+// power needs exponents wider than a word (FLINT then aborts the process)
+// or gigabytes of terms, so a power whose degree would pass the limit that
+// a single exponent has is an error instead.
+void check_power_degree(const RatFun &a, int64_t n) {
+  long degree = std::max(total_degree(a.num), total_degree(a.den));
+  if (degree <= 0) return;
+  if (degree > kMaxExpandedPower || n > kMaxExpandedPower / degree)
+    runtime_error(current_call_loc(),
+                  "simplify: expanding a power would give a polynomial of degree above " +
+                      std::to_string(kMaxExpandedPower) + " (nested powers multiply degrees)");
+}
+
+} // namespace
+
 RatFun rf_pow(const RatFun &a, int64_t n) {
   const PolyRing &r = a.num.ring();
   if (n == 0) {
@@ -249,6 +276,7 @@ RatFun rf_pow(const RatFun &a, int64_t n) {
   }
   if (n < 0) return rf_pow(rf_inv(a), -n);
   if (n == 1) return a;
+  check_power_degree(a, n);
   RatFun f(r);
   // A power of a coprime pair is coprime, and a power of a monic polynomial is monic.
   SICM_ASSERT(fmpq_mpoly_pow_ui(f.num.get(), a.num.get(), static_cast<ulong>(n), r.ctx()));
