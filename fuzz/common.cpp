@@ -264,7 +264,13 @@ Approx NumEval::node(ExprId id) {
     case Op::Sqrt: {
       C s = std::sqrt(x);
       if (std::find(negative_.begin(), negative_.end(), id) != negative_.end()) s = -s;
-      r = unary(s, 0.5 / s, a[0]);
+      // Near a zero argument the first-order bound e/(2|s|) grows without
+      // limit (and is inf/NaN at 0), but a root moves at most sqrt(e) when
+      // its argument moves by e (|sqrt a - sqrt b| <= sqrt|a - b| on one
+      // branch): (sqrt (sqrt (expt (- x x') 4))) with x' = x rounded is a
+      // few ulps of x, not infinitely uncertain (simplify-7).
+      double e = a[0].e == 0 ? 0 : std::min(0.5 * a[0].e / std::abs(s), std::sqrt(a[0].e));
+      r = {s, e + 2 * kU * std::abs(s)};
       break;
     }
     case Op::Exp: r = unary(std::exp(x), std::exp(x), a[0]); break;
