@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <unordered_set>
 
+#include "eval/limits.hpp"
 #include "eval/number.hpp"
 #include "eval/procedure.hpp"
 #include "eval/value.hpp"
@@ -97,6 +98,18 @@ int main(int argc, char **argv) {
 }
 
 namespace fuzz {
+
+void limit_expression_nodes(uint64_t nodes) {
+  sicm::Limits limits;
+  limits.max_expression_nodes = nodes;
+  limits.max_steps = sicm::kUnlimited;
+  limits.max_memory = sicm::kUnlimited; // libFuzzer's -rss_limit_mb watches memory
+  sicm::set_limits(limits, false);
+}
+
+void begin_input() {
+  sicm::begin_evaluation(sicm::SrcLoc{});
+}
 
 void reset_stack_limit() {
   sicm::set_stack_limit(g_stack_base, kStackBytes - kStackGuardMargin);

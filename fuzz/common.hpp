@@ -33,6 +33,14 @@ using sicm::Symbol;
 // trips it on purpose to cancel a run).
 void reset_stack_limit();
 
+// Put sicm's expression size limit (--max-expression-nodes) in force at
+// `nodes`, no other limit; begin_input counts it from zero again, as the
+// REPL does for each form. The simplify and emit targets use it to refuse
+// expansions that would take FLINT minutes (the limit's own check of
+// expansions, eval/limits.hpp) well inside libFuzzer's -timeout.
+void limit_expression_nodes(uint64_t nodes);
+void begin_input();
+
 // Stop the process with a message on stderr (libFuzzer reports the abort as
 // a crash and saves the input).
 [[noreturn]] void fail(const std::string &what);

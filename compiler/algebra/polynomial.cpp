@@ -13,10 +13,12 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstdlib>
 #include <new>
 #include <string>
 
+#include "eval/limits.hpp"
 #include "eval/number.hpp"
 #include "syntax/error.hpp"
 
@@ -104,9 +106,86 @@ Poly poly_add(const Poly &a, const Poly &b) {
   return c;
 }
 
+namespace {
+
+// Upper bounds on the number of terms of an expansion, so that one that
+// would not fit the expression size limit is refused before FLINT spends
+// minutes (or gigabytes) on it: a product has at most the product of its
+// factors' numbers of terms, a power p^n of a t-term p at most the
+// multinomial count C(n + t - 1, t - 1), and either at most the number of
+// monomials within its degree in each variable. The bounds are in floating
+// point, as they can pass any integer type.
+
+// The monomials within degree n * deg_v(a) + deg_v(b) in each variable v
+// (b may be absent).
+double dense_terms(const Poly &a, double n, const Poly *b) {
+  const fmpq_mpoly_ctx_struct *ctx = a.ctx();
+  slong vars = fmpq_mpoly_ctx_nvars(ctx);
+  std::vector<slong> da(static_cast<size_t>(vars)), db(static_cast<size_t>(vars), 0);
+  // Degrees that do not fit a word: no bound from this side.
+  if (!fmpq_mpoly_degrees_fit_si(a.get(), ctx)) return HUGE_VAL;
+  fmpq_mpoly_degrees_si(da.data(), a.get(), ctx);
+  if (b) {
+    if (!fmpq_mpoly_degrees_fit_si(b->get(), ctx)) return HUGE_VAL;
+    fmpq_mpoly_degrees_si(db.data(), b->get(), ctx);
+  }
+  double terms = 1;
+  for (size_t v = 0; v < da.size(); ++v)
+    terms *= n * static_cast<double>(std::max<slong>(da[v], 0)) +
+             static_cast<double>(std::max<slong>(db[v], 0)) + 1;
+  return terms;
+}
+
+// Products whose bound is below this are not examined further: the cost
+// of the check stays out of the common case.
+constexpr double kSmallExpansion = 1e4;
+
+void check_product_size(const Poly &a, const Poly &b) {
+  double terms = static_cast<double>(a.length()) * static_cast<double>(b.length());
+  if (terms < kSmallExpansion) return;
+  check_expression_growth(std::min(terms, dense_terms(a, 1, &b)), "expanding a product");
+}
+
+void check_power_size(const Poly &p, int64_t n) {
+  double t = static_cast<double>(p.length());
+  if (t <= 1) return;
+  // C(n + t - 1, k) with k = min(n, t - 1), stopping once it is huge.
+  double k = std::min(static_cast<double>(n), t - 1), terms = 1;
+  for (double i = 1; i <= k && terms < 1e300; ++i)
+    terms = terms * (static_cast<double>(n) + t - i) / i;
+  if (terms < kSmallExpansion) return;
+  check_expression_growth(std::min(terms, dense_terms(p, static_cast<double>(n), nullptr)),
+                          "expanding a power of a sum");
+}
+
+// GMP aborts the process when a number outgrows its size field, and a
+// coefficient of more than this many bits (32 MiB) is a mistake, not a
+// computation: the bound expt has for exact numbers (eval/number.cpp).
+constexpr double kMaxCoefficientBits = 268435456.0;
+
+// The coefficients of p^n have at most n times the bits of p's content and
+// of its largest integral coefficient, and n log2(t) more from the
+// multinomial counts. A power of an exact constant of 53 bits nested
+// fourteen deep, ((c^-4)^-4)..., is 14 billion bits.
+void check_power_bits(const Poly &p, int64_t n) {
+  const fmpq_mpoly_struct *a = p.get();
+  double content = static_cast<double>(
+      std::max(fmpz_bits(fmpq_numref(a->content)), fmpz_bits(fmpq_denref(a->content))));
+  double integral = static_cast<double>(std::abs(fmpz_mpoly_max_bits(a->zpoly)));
+  double bits =
+      static_cast<double>(n) * (content + integral + std::log2(static_cast<double>(p.length())));
+  if (bits > kMaxCoefficientBits)
+    runtime_error(current_call_loc(),
+                  "simplify: expanding a power would give coefficients of more than 268435456 "
+                  "bits; use inexact numbers (exact->inexact) for a flonum result");
+}
+
+} // namespace
+
 Poly poly_mul(const Poly &a, const Poly &b) {
   if (a.is_one()) return b;
   if (b.is_one()) return a;
+  check_product_size(a, b);
   Poly c(a.ring());
   fmpq_mpoly_mul(c.get(), a.get(), b.get(), a.ctx());
   return c;
@@ -277,6 +356,10 @@ RatFun rf_pow(const RatFun &a, int64_t n) {
   if (n < 0) return rf_pow(rf_inv(a), -n);
   if (n == 1) return a;
   check_power_degree(a, n);
+  check_power_size(a.num, n);
+  check_power_size(a.den, n);
+  check_power_bits(a.num, n);
+  check_power_bits(a.den, n);
   RatFun f(r);
   // A power of a coprime pair is coprime, and a power of a monic polynomial is monic.
   SICM_ASSERT(fmpq_mpoly_pow_ui(f.num.get(), a.num.get(), static_cast<ulong>(n), r.ctx()));

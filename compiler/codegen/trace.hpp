@@ -1,4 +1,5 @@
-// Tracing: a procedure applied to symbols shaped like its arguments, giving its result as expressions.
+// Tracing: a procedure applied to symbols shaped like its arguments, giving its result as
+// expressions.
 //
 // Requires: a procedure that computes its result from its arguments by generic
 // arithmetic (numbers it captures fold into constants). Produces: a Trace, one
@@ -32,6 +33,13 @@ struct Trace {
 // a one-line reason in *why_not when the procedure cannot be traced. Errors
 // the procedure raises on symbolic arguments are caught and become the reason.
 bool trace_procedure(Value proc, Value sample_args, Trace *out, std::string *why_not);
+
+// Which form of an output a kernel computes: `simplified`, unless
+// simplifying multiplied the size of `traced` (the simplifier's canonical
+// form expands powers of sums: a 216th power of a trinomial is 23,653
+// terms, a megabyte of C, and cancellation eats the expanded sum's value);
+// then `traced`, the same function.
+ExprId kernel_output_form(ExprId traced, ExprId simplified);
 
 // True if v is a number or a nested up/down structure whose leaves are numbers.
 bool is_numeric_shape(Value v);

@@ -125,6 +125,14 @@ std::string show_count(uint64_t n) {
   return n == kUnlimited ? "unlimited" : std::to_string(n);
 }
 
+// A count estimated in floating point: exact digits while they are
+// meaningful, then scientific notation.
+std::string show_estimate(double n) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, n < 1e15 ? "%.0f" : "%.3g", n);
+  return buf;
+}
+
 std::string show_bytes(uint64_t n) {
   if (n == kUnlimited) return "unlimited";
   const char *units = "KMGT";
@@ -397,6 +405,17 @@ void begin_evaluation(SrcLoc where) {
   limits_detail::expr_ceiling =
       max == kUnlimited || max > kUnlimited - g_expr_base ? kUnlimited : g_expr_base + max;
   reset_call_loc(where);
+}
+
+void check_expression_growth(double terms, const char *what) {
+  if (limits_detail::interrupt.load(std::memory_order_relaxed)) interrupted(somewhere());
+  uint64_t ceiling = limits_detail::expr_ceiling;
+  if (ceiling == kUnlimited) return;
+  double room = static_cast<double>(ceiling) - static_cast<double>(expr_count());
+  if (terms < room) return;
+  limit_error(somewhere(), "expression size limit (--max-expression-nodes=" +
+                               show_count(g_limits.max_expression_nodes) + ") exceeded: " + what +
+                               " could have up to " + show_estimate(terms) + " terms");
 }
 
 void request_interrupt() {

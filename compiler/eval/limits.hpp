@@ -116,6 +116,14 @@ inline void count_step(const SrcLoc &where) {
     limits_detail::checkpoint(where);
 }
 
+// The simplifier is about to expand a product or power in FLINT, outside
+// the arena, into a polynomial of up to `terms` terms (an upper bound), each
+// of which becomes a node or more when it is turned back into an
+// expression: the expression size error now, naming `what`, if they would
+// not fit in what is left of the limit, rather than after minutes in FLINT
+// (which the interrupt cannot stop either).
+void check_expression_growth(double terms, const char *what);
+
 // The expression arena, holding `count` nodes, is about to make another.
 inline void check_expression_nodes(size_t count) {
   if (count >= limits_detail::expr_ceiling ||
