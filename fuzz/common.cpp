@@ -145,6 +145,7 @@ namespace {
 
 using C = std::complex<double>;
 constexpr double kU = DBL_EPSILON / 2; // unit roundoff
+constexpr double kEta = 0x1p-1074;     // the smallest subnormal, a bound on underflow's error
 const C kNaN(NAN, NAN);
 
 bool finite(C z) {
@@ -312,6 +313,11 @@ Approx NumEval::node(ExprId id) {
     case Op::Cosh: r = unary(std::cosh(x), std::sinh(x), a[0]); break;
     case Op::Abs: r = {std::abs(x), a[0].e + kU * std::abs(x)}; break;
     }
+    // Underflow: below the normal range a result's error is absolute, up to
+    // half the smallest subnormal (fl(x op y) = (x op y)(1 + d) + h, |h| <=
+    // 2^-1075). A factor that underflowed to 0 then carries a bound that
+    // the other factors scale, instead of claiming an exact 0.
+    r.e += kEta;
     break;
   }
   }

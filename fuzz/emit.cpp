@@ -244,31 +244,6 @@ Value interpret(ExprId id, const std::vector<double> &point, ValueMemo &memo) {
   return v;
 }
 
-// Does id hold an integer power of magnitude 2^20 or more? (Chained powers
-// reach them: (expt (expt u 17) 17) ..., which the simplifier multiplies
-// out.)
-// Each node is visited once: a tree walk of a DAG whose nodes are shared
-// is exponential (a 20-deep chain of (+ u u) ran for minutes).
-bool has_huge_power(ExprId root) {
-  std::unordered_set<ExprId> seen;
-  std::vector<ExprId> todo{root};
-  while (!todo.empty()) {
-    ExprId id = todo.back();
-    todo.pop_back();
-    if (!seen.insert(id).second || expr_kind(id) != ExprKind::Apply) continue;
-    int64_t n;
-    if (expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), &n) &&
-        (n >= (int64_t(1) << 20) || n <= -(int64_t(1) << 20)))
-      return true;
-    if (expr_is_apply(id, Op::Expt) && expr_is_exact_integer(expr_arg(id, 1)) &&
-        !expr_get_int64(expr_arg(id, 1), &n))
-      return true; // beyond int64
-    for (ExprId a : expr_arg_vector(id))
-      todo.push_back(a);
-  }
-  return false;
-}
-
 // A bound on the degree of id as a power of its leaves: a leaf 1, (expt a
 // n) |n| times a's, a product or quotient the sum of its arguments', anything
 // else the largest of its arguments'; saturating at 2^80. With constant_only,
@@ -678,11 +653,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       return 0; // a division by something that simplifies to zero
     }
   }
-  // Known bug (fuzz/crashes-found/README.md, emit-1): a huge integer power
-  // of a constant makes the C compiler run for minutes.
+  // Known (fuzz/crashes-found/README.md, emit-1): a chain of small powers
+  // of a constant, which only an unsimplified kernel holds, makes gcc -O2
+  // run for minutes. (A single huge power is a pow call since emit-1's
+  // first form was fixed.)
   degrees.clear();
   for (ExprId o : t.outputs)
-    if (has_huge_power(o) || has_huge_constant(o, degrees)) return 0;
+    if (has_huge_constant(o, degrees)) return 0;
   ++g_stats.kernels;
   g_stats.simplified += simplified;
   Pending k;

@@ -388,6 +388,15 @@ void check_values(ExprId e, ExprId s, const Value sym[3], uint64_t seed) {
       ++g_stats.unjudged;
       continue;
     }
+    // With a root of a root, the simplified form may hold roots the
+    // original does not ((sqrt (sqrt x)) from (expt (sqrt x) -3/2)), whose
+    // principal branches no choice of signs of the original's roots
+    // accounts for: such a mismatch is not judged. (simplify-7, which
+    // first set this aside, was the target's own sqrt bound, since fixed.)
+    if (has_nested_root(e) || has_nested_root(s)) {
+      ++g_stats.unjudged;
+      continue;
+    }
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   "at x = %.17g, y = %.17g, z = %.17g:\n  original   = %.17g%+.17gi (error bound "

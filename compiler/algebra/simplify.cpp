@@ -736,19 +736,25 @@ private:
     case Op::Expt: {
       int64_t e;
       SICM_ASSERT(expr_get_int64(args[1], &e)); // exponents beyond int64 are hopeless anyway
-      // (u^a)^b is u^(ab) for nonzero integers a and b (and u = 0 divides
-      // by zero both ways when one is negative): one power of u costs far
-      // less than a power of u^a expanded, which is a polynomial of many
-      // terms ((x + y + .002)^12 has 91; raising it to the 18th took 40 s
-      // where u^216 takes 0.1 s).
+      // (u^a)^b is u^(ab) for nonzero integers a and b and u not zero:
+      // one power of u costs far less than a power of u^a expanded, which
+      // is a polynomial of many terms ((x + y + .002)^12 has 91; raising
+      // it to the 18th took 40 s where u^216 takes 0.1 s). A zero u keeps
+      // the chain, whose negative powers divide by zero: ((u^-1)^-1) is
+      // an error, u^1 would not be.
       ExprId base = args[0];
-      int64_t inner, product;
-      while (e != 0 && expr_is_apply(base, Op::Expt) && expr_get_int64(expr_arg(base, 1), &inner) &&
-             inner != 0 && !__builtin_mul_overflow(e, inner, &product)) {
-        e = product;
+      int64_t inner, product, combined = e;
+      while (combined != 0 && expr_is_apply(base, Op::Expt) &&
+             expr_get_int64(expr_arg(base, 1), &inner) && inner != 0 &&
+             !__builtin_mul_overflow(combined, inner, &product)) {
+        combined = product;
         base = expr_arg(base, 0);
       }
-      RatFun b = convert(base);
+      if (base != args[0]) {
+        RatFun u = convert(base);
+        if (!u.is_zero()) return rf_pow(u, combined);
+      }
+      RatFun b = convert(args[0]);
       if (b.is_zero() && e >= 0) return e == 0 ? rf_constant_int(1) : RatFun(*ring_);
       return rf_pow(b, e);
     }

@@ -12,8 +12,9 @@
 // operation: floating-point arithmetic is not associative, so the C must
 // evaluate the tree as built. Sums with negated terms are written with `-`
 // (a + (-b) and a - b are the same IEEE operation). Powers with exponent of
-// magnitude 4 or more are computed by repeated squaring into temporaries;
-// negative integer powers are 1.0 divided by the positive power.
+// magnitude 4 to kMaxSquaringPower are computed by repeated squaring into
+// temporaries, larger ones by pow; negative integer powers are 1.0 divided
+// by the positive power.
 //
 // Numbers are emitted as the double they round to (exact rationals correctly
 // rounded), in the shortest form that reads back exactly. No user text
@@ -24,6 +25,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <functional>
 #include <map>
 #include <unordered_map>
@@ -36,6 +39,10 @@
 namespace sicm {
 
 namespace {
+
+// Integer powers up to this are multiplications (six squarings at most);
+// above it, pow (see libm_power).
+constexpr uint64_t kMaxSquaringPower = 64;
 
 // C precedence levels of the forms the emitter writes, tightest first.
 enum Prec : int { kAtom = 0, kUnary = 1, kMul = 2, kAdd = 3 };
@@ -260,6 +267,7 @@ private:
     if (m == 1) return ref(base);
     auto hit = powers_.find({base, m});
     if (hit != powers_.end()) return {hit->second, kAtom};
+    if (m > kMaxSquaringPower) return libm_power(base, m);
     std::string b = operand(base);
     if (m == 2) return {b + " * " + b, kMul};
     if (m == 3) {
@@ -283,6 +291,22 @@ private:
       square = s->second;
     }
     return product(parts);
+  }
+
+  // base^m by pow: within an ulp, where squaring rounds once a step, and
+  // what gcc -O2 folds at once for a constant base, where it ran for
+  // minutes folding fifty squarings (fuzz emit-1). An m past 2^53 is
+  // rounded to the nearest double, which is even: the sign of an odd
+  // power is put back with copysign.
+  Code libm_power(ExprId base, uint64_t m) {
+    char exponent[32];
+    std::snprintf(exponent, sizeof exponent, "%.17g.0", static_cast<double>(m));
+    if (std::strchr(exponent, 'e')) // past 1e17 %.17g switches to an exponent
+      std::snprintf(exponent, sizeof exponent, "%.17g", static_cast<double>(m));
+    std::string b = ref(base).text;
+    std::string p = "pow(" + b + ", " + exponent + ")";
+    if ((m & 1) && m > (uint64_t(1) << 53)) p = "copysign(" + p + ", " + b + ")";
+    return {p, kAtom};
   }
 
   Code call(const char *fn, const std::vector<ExprId> &args) {
