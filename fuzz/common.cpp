@@ -263,7 +263,11 @@ Approx NumEval::node(ExprId id) {
     }
     case Op::Expt: {
       int64_t k;
-      if (expr_get_int64(ids[1], &k) && k > -64 && k < 64) {
+      // An integer power by repeated squaring, whatever its size: complex
+      // pow (exp(k log x)) gives a negative real base an imaginary part of
+      // about k pi u |v| (2e30 i for (-2.35)^119), and tan of that is i, a
+      // value whose derivative 1 + tan^2 hides the argument's error.
+      if (expr_get_int64(ids[1], &k)) {
         C v = power(x, k);
         C d = k == 0 ? C(0) : static_cast<double>(k) * power(x, k - 1);
         double steps = 2 * (1 + std::log2(1 + std::fabs(static_cast<double>(k))));
