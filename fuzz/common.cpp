@@ -291,7 +291,14 @@ Approx NumEval::node(ExprId id) {
       r = {s, e + 2 * kU * std::abs(s)};
       break;
     }
-    case Op::Exp: r = unary(std::exp(x), std::exp(x), a[0]); break;
+    case Op::Exp: {
+      // Not first order: |exp(p + d) - exp(p)| <= |exp(p)| (exp|d| - 1).
+      // With the derivative at the computed p, an exponent that cancelled
+      // to -1000 (an expanded 16th power, 1e3 off) claimed an exact 0.
+      C v = std::exp(x);
+      r = {v, std::abs(v) * std::expm1(a[0].e) + 2 * kU * std::abs(v)};
+      break;
+    }
     case Op::Log: r = unary(std::log(x), C(1) / x, a[0]); break;
     case Op::Sin: r = unary(std::sin(x), std::cos(x), a[0]); break;
     case Op::Cos: r = unary(std::cos(x), std::sin(x), a[0]); break;
