@@ -300,8 +300,17 @@ Approx NumEval::node(ExprId id) {
       break;
     }
     case Op::Log: r = unary(std::log(x), C(1) / x, a[0]); break;
-    case Op::Sin: r = unary(std::sin(x), std::cos(x), a[0]); break;
-    case Op::Cos: r = unary(std::cos(x), std::sin(x), a[0]); break;
+    // |sin''| <= 1 on the reals: the second-order term keeps the bound
+    // honest where the argument's error is large (sin of x^72 = 5e14,
+    // known to 0.8), which the derivative at the computed point is not.
+    case Op::Sin:
+      r = unary(std::sin(x), std::cos(x), a[0]);
+      r.e += 0.5 * a[0].e * a[0].e;
+      break;
+    case Op::Cos:
+      r = unary(std::cos(x), std::sin(x), a[0]);
+      r.e += 0.5 * a[0].e * a[0].e;
+      break;
     case Op::Tan: {
       C t = std::tan(x);
       r = unary(t, 1.0 + t * t, a[0]);
@@ -316,6 +325,9 @@ Approx NumEval::node(ExprId id) {
         double y = x.real(), xx = a[1].v.real(), v = std::atan2(y, xx);
         r = {v, (std::fabs(xx) * a[0].e + std::fabs(y) * a[1].e) / (xx * xx + y * y) +
                     2 * kU * std::fabs(v)};
+        // On the branch cut (x < 0) a y whose sign is not known gives
+        // either of +-pi: the value is known to 2 pi only.
+        if (xx <= a[1].e && std::fabs(y) <= a[0].e) r.e = std::max(r.e, 2 * M_PI);
       } else {
         r = {kNaN, NAN}; // atan2 of complex values: not needed
       }
