@@ -323,11 +323,23 @@ Approx NumEval::node(ExprId id) {
         r = unary(std::atan(x), C(1) / (1.0 + x * x), a[0]);
       } else if (x.imag() == 0 && a[1].v.imag() == 0) {
         double y = x.real(), xx = a[1].v.real(), v = std::atan2(y, xx);
-        r = {v, (std::fabs(xx) * a[0].e + std::fabs(y) * a[1].e) / (xx * xx + y * y) +
-                    2 * kU * std::fabs(v)};
-        // On the branch cut (x < 0) a y whose sign is not known gives
-        // either of +-pi: the value is known to 2 pi only.
-        if (xx <= a[1].e && std::fabs(y) <= a[0].e) r.e = std::max(r.e, 2 * M_PI);
+        double ey = a[0].e, ex = a[1].e;
+        r = {v, (std::fabs(xx) * ey + std::fabs(y) * ex) / (xx * xx + y * y)};
+        // Not only first order: near the origin atan2 turns fast, and a y
+        // known to 0.6 at 0.5 over x = 0.04 may lie on either side of 0
+        // (emit-6: the first-order bound there was 0.1, the two sides
+        // differ by 2.7). The angle of every point of the box of (x, y)
+        // and its errors lies between those of its corners, unless the box
+        // holds the origin or crosses the branch cut (x < 0, either sign of
+        // y: -pi or pi), where the value is known to 2 pi only.
+        if (std::fabs(y) <= ey && xx <= ex) {
+          r.e = 2 * M_PI;
+        } else {
+          for (double cy : {y - ey, y + ey})
+            for (double cx : {xx - ex, xx + ex})
+              r.e = std::max(r.e, std::fabs(std::atan2(cy, cx) - v));
+        }
+        r.e += 2 * kU * std::fabs(v);
       } else {
         r = {kNaN, NAN}; // atan2 of complex values: not needed
       }

@@ -68,6 +68,13 @@ namespace {
 // The normal-form search of the trig rules tries 2^n forms for n angles;
 // beyond this many angles only the greedy search runs.
 constexpr size_t kMaxTrigAngles = 4;
+// Rewriting cos^2 as 1 - sin^2 in a polynomial of degree d in cos expands
+// (1 - sin^2)^(d/2): its powers are kept, so the work and memory grow as d^3
+// times the coefficients' bits. An angle whose sine or cosine appears to a
+// higher degree than this is left as it is (emit-4 in
+// fuzz/crashes-found/README.md: cos(1/3) to the 12,800th took gigabytes).
+// No identity needs more: a form that the rewrite shortens has low degree.
+constexpr long kMaxTrigDegree = 64;
 
 std::vector<ExprId> g_memo; // id -> canonical form, kNoExpr when not known yet
 
@@ -570,6 +577,8 @@ public:
     for (ExprId s : vars_) {
       if (!is_op1(s, Op::Sin)) continue;
       Angle a{ring_->index_of(s), ring_->index_of(partner(s)), RatFun(*ring_), RatFun(*ring_)};
+      if (max_degree(f, a.sin) > kMaxTrigDegree || max_degree(f, a.cos) > kMaxTrigDegree)
+        continue;
       if (degree2(f, a.sin) || degree2(f, a.cos)) {
         a.one_minus_sin2 =
             rf_add(rf_constant_int(1), rf_neg(rf_pow(rf_variable(*ring_, a.sin), 2)));
@@ -615,9 +624,11 @@ private:
     RatFun one_minus_sin2, one_minus_cos2; // what cos^2 and sin^2 become
   };
 
-  static bool degree2(const RatFun &f, int v) {
-    return poly_degree_in(f.num, v) >= 2 || poly_degree_in(f.den, v) >= 2;
+  static long max_degree(const RatFun &f, int v) {
+    return std::max(poly_degree_in(f.num, v), poly_degree_in(f.den, v));
   }
+
+  static bool degree2(const RatFun &f, int v) { return max_degree(f, v) >= 2; }
 
   RatFun greedy_trig(RatFun f, const std::vector<Angle> &angles) {
     bool improved = true;
@@ -718,10 +729,19 @@ private:
     std::vector<ExprId> args = expr_arg_vector(id);
     switch (op) {
     case Op::Add: {
-      RatFun f = convert(args[0]);
-      for (size_t i = 1; i < args.size(); i++)
-        f = rf_add(f, convert(args[i]));
-      return f;
+      // Summed pairwise: adding a term to an n-term polynomial costs O(n)
+      // (FLINT rescales every coefficient to the common content), so adding
+      // the terms of a canonical sum one by one is quadratic. Negating a
+      // simplified 46,376-term sum took 18 s that way (emit-4's timeouts,
+      // fuzz/crashes-found/README.md).
+      std::vector<RatFun> terms;
+      terms.reserve(args.size());
+      for (ExprId a : args)
+        terms.push_back(convert(a));
+      for (size_t width = 1; width < terms.size(); width *= 2)
+        for (size_t i = 0; i + width < terms.size(); i += 2 * width)
+          terms[i] = rf_add(terms[i], terms[i + width]);
+      return std::move(terms[0]);
     }
     case Op::Mul: {
       RatFun f = convert(args[0]);

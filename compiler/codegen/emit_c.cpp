@@ -247,6 +247,11 @@ private:
   }
 
   Code mul(const std::vector<ExprId> &args) {
+    // An exact 0 makes the product the exact 0 in generic arithmetic, as in
+    // MIT ((* 0 x) is 0 for a flonum x, even an infinite one); in C,
+    // -1.0 * 0.0 is -0., which atan2 and 1/x tell from 0 (fuzz emit-5).
+    for (ExprId a : args)
+      if (expr_kind(a) == ExprKind::Rational && number_value(a) == 0) return literal(0.0);
     if (expr_is_number(args[0]) && number_value(args[0]) == -1.0 && args.size() > 1) {
       std::vector<Code> rest;
       for (size_t i = 1; i < args.size(); ++i)

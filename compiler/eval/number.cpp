@@ -635,7 +635,12 @@ Value flonum_base_expt(double x, Value e) {
     mpz_neg(y, y);
     return Value::flonum(1.0 / flonum_expt_positive(x, y));
   }
-  return Value::flonum(flonum_expt_general(x, to_double(e)));
+  // The sign of a negative base's power is the exponent's parity, which an
+  // exponent past 2^53 loses when rounded to a double (always even there):
+  // (expt -2.08 -16677181699666569) is -0., as repeated squaring gives it.
+  double r = flonum_expt_general(x, to_double(e));
+  if (x < 0) r = mpz_odd_p(y.v) ? -std::fabs(r) : std::fabs(r);
+  return Value::flonum(r);
 }
 
 // Exact base to an exact integer power.
