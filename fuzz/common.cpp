@@ -353,6 +353,12 @@ Approx NumEval::node(ExprId id) {
     // 2^-1075). A factor that underflowed to 0 then carries a bound that
     // the other factors scale, instead of claiming an exact 0.
     r.e += kEta;
+    // A value below the smallest normal double has absolute accuracy only,
+    // and another correct order of evaluation may not reach it at all:
+    // ((x^192)^-4) is 1e-316 as pow(y, -4) and 0 as C's 1.0 / (y * y * y
+    // * y), whose y^4 overflowed. A root then makes either a normal number
+    // (1e-158 against 0). Such a value is known to DBL_MIN.
+    if (std::abs(r.v) < DBL_MIN) r.e = std::max(r.e, DBL_MIN);
     break;
   }
   }
