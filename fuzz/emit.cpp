@@ -307,8 +307,6 @@ std::string slurp(const std::string &path) {
 
 // Compile src into a shared object; "" on success, else why not (the
 // compiler's messages, or that it ran past kCompileSeconds and was killed).
-// -Wno-unused-variable: the emitter can leave a temporary unused (known bug:
-// fuzz/crashes-found/README.md, emit-2); remove it with the fix.
 std::string compile(const std::string &c_path, const std::string &so_path,
                     int seconds = kCompileSeconds) {
   std::string log = c_path + ".log";
@@ -318,7 +316,6 @@ std::string compile(const std::string &c_path, const std::string &so_path,
                         "-Wall",
                         "-Wextra",
                         "-Werror",
-                        "-Wno-unused-variable",
                         "-fPIC",
                         "-shared",
                         "-o",

@@ -344,3 +344,20 @@ TEST(Codegen, ProductWithAnExactZeroIsZero) {
   EXPECT_EQ(c.find("-1.0"), std::string::npos) << c;
   EXPECT_NE(c.find("atan2(0.0, in[0])"), std::string::npos) << c;
 }
+
+// (expt u 0) is written 1.0 and a product with an exact 0 is 0.0, without
+// their arguments, so nothing under them may get a temporary: a power chain
+// under (expt ... 0) left `const double t33` unread, which -Wall -Werror
+// rejects (fuzz emit-2). Only unsimplified kernels hold such nodes.
+TEST(Codegen, NothingUnderAConstantFormGetsATemporary) {
+  Symbol *x = make_uninterned_symbol("x0").symbol();
+  ExprId cube = expr_apply(Op::Expt, {expr_symbol(x), expr_integer(-3)});
+  ExprId chain = expr_apply(Op::Expt, {cube, expr_integer(9)}); // names cube, squares
+  ExprId one = expr_apply(Op::Expt, {chain, expr_integer(0)});
+  ExprId zero = expr_apply(Op::Mul, {expr_integer(0), chain, chain});
+  std::string c = emit_c_assignments({one, zero}, {"out[0]", "out[1]"},
+                                     [](Symbol *) { return "in[0]"; }, "t", "");
+  EXPECT_EQ(c.find("const double"), std::string::npos) << c;
+  EXPECT_NE(c.find("out[0] = 1.0;"), std::string::npos) << c;
+  EXPECT_NE(c.find("out[1] = 0.0;"), std::string::npos) << c;
+}
