@@ -2138,8 +2138,17 @@ template <const char *Name> Value P_list_cxr(Value *a, int n) {
     for (int k = 0; k < 5; ++k)
       if (name == nth[k]) ops = "a" + std::string(static_cast<size_t>(k), 'd');
   }
+  // Only the cells on the path matter: (cadr l) of a long static list
+  // walked all of l for run-time lists before, once per call, which made a
+  // loop over the list quadratic (stdlib/stability.sicm's manifolds).
   Value v = a[0];
-  if (!contains_rtlist(v)) return call_original(Name, a, n);
+  bool run_time = as_rtlist(v) != nullptr;
+  for (size_t i = ops.size(); i-- > 0 && !run_time && is_pair(v);) {
+    v = ops[i] == 'a' ? car(v) : cdr(v);
+    run_time = as_rtlist(v) != nullptr;
+  }
+  if (!run_time) return call_original(Name, a, n);
+  v = a[0];
   for (size_t i = ops.size(); i-- > 0;) {
     Value arg[1] = {v};
     v = ops[i] == 'a' ? P_list_car(arg, 1) : P_list_cdr(arg, 1);
