@@ -266,7 +266,14 @@ double degree(ExprId id, bool constant_only, std::unordered_map<ExprId, double> 
   double d = 0;
   bool constant = true;
   int64_t n;
-  if (expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), &n)) {
+  if (expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), &n) && n == 0) {
+    d = 1; // written 1.0, whatever the base: (log (expt x0 0)) is a constant
+  } else if (expr_is_apply(id, Op::Mul) &&
+             std::any_of(args.begin(), args.end(), [](ExprId a) {
+               return expr_kind(a) == ExprKind::Rational && expr_number_sign(a) == 0;
+             })) {
+    d = 1; // written 0.0, as (expt u 0) is written 1.0 (emit_c.cpp)
+  } else if (expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), &n)) {
     double base = degree(args[0], constant_only, memo);
     constant = base > 0;
     d = base * std::max<double>(1, std::fabs(static_cast<double>(n)));
