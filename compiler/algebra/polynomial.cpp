@@ -146,6 +146,33 @@ void check_product_size(const Poly &a, const Poly &b) {
   check_expression_growth(std::min(terms, dense_terms(a, 1, &b)), "expanding a product");
 }
 
+// A product's degree in each variable is the sum of its factors'. Past
+// kMaxExpandedPower the canonical form has no power for it (C3 in
+// algebra/expr.hpp): y x^60000 x^60000 gave (* y (expt x 120000)), which
+// failed the simplifier's own check (an internal error), so such a product
+// is an error, as a power of that degree is (check_power_degree).
+void check_product_degree(const Poly &a, const Poly &b) {
+  const fmpq_mpoly_ctx_struct *ctx = a.ctx();
+  if (!fmpq_mpoly_total_degree_fits_si(a.get(), ctx) ||
+      !fmpq_mpoly_total_degree_fits_si(b.get(), ctx) ||
+      fmpq_mpoly_total_degree_si(a.get(), ctx) + fmpq_mpoly_total_degree_si(b.get(), ctx) >
+          kMaxExpandedPower) {
+    slong vars = fmpq_mpoly_ctx_nvars(ctx);
+    std::vector<slong> da(static_cast<size_t>(vars)), db(static_cast<size_t>(vars));
+    bool fit = fmpq_mpoly_degrees_fit_si(a.get(), ctx) && fmpq_mpoly_degrees_fit_si(b.get(), ctx);
+    if (fit) {
+      fmpq_mpoly_degrees_si(da.data(), a.get(), ctx);
+      fmpq_mpoly_degrees_si(db.data(), b.get(), ctx);
+    }
+    for (size_t v = 0; fit && v < da.size(); ++v)
+      fit = std::max<slong>(da[v], 0) + std::max<slong>(db[v], 0) <= kMaxExpandedPower;
+    if (!fit)
+      runtime_error(current_call_loc(),
+                    "simplify: a product would have degree above " +
+                        std::to_string(kMaxExpandedPower) + " in one of its variables");
+  }
+}
+
 void check_power_size(const Poly &p, int64_t n) {
   double t = static_cast<double>(p.length());
   if (t <= 1) return;
@@ -186,6 +213,7 @@ Poly poly_mul(const Poly &a, const Poly &b) {
   if (a.is_one()) return b;
   if (b.is_one()) return a;
   check_product_size(a, b);
+  check_product_degree(a, b);
   Poly c(a.ring());
   fmpq_mpoly_mul(c.get(), a.get(), b.get(), a.ctx());
   return c;
