@@ -697,7 +697,19 @@ Value exact_base_rational_expt(Value b, Value e) {
 Value zero_base_expt(Value b, Value e) {
   if (is_exact_zero(e)) return Value::fixnum(1);
   int sign = num_sign(e);
-  if (sign > 0) return is_flonum(b) ? b : Value::fixnum(0);
+  if (sign > 0 && !is_flonum(b)) return Value::fixnum(0);
+  if (sign > 0) {
+    // The sign of a flonum zero's power is the exponent's parity, as
+    // repeated multiplication gives it: (expt -0. 12) is 0., (expt -0. 3)
+    // -0.; any other exponent gives 0., as pow does.
+    bool odd = false;
+    if (is_exact_integer(e)) {
+      Z n;
+      to_mpz(e, n);
+      odd = mpz_odd_p(n.v);
+    }
+    return Value::flonum(odd ? b.d : 0.0);
+  }
   if (sign == 0 && !std::isnan(to_double(e))) bad_range(e, 2, "expt");
   divide_by_zero("expt");
 }
