@@ -269,9 +269,7 @@ double degree(ExprId id, bool constant_only, std::unordered_map<ExprId, double> 
   if (expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), &n) && n == 0) {
     d = 1; // written 1.0, whatever the base: (log (expt x0 0)) is a constant
   } else if (expr_is_apply(id, Op::Mul) &&
-             std::any_of(args.begin(), args.end(), [](ExprId a) {
-               return expr_kind(a) == ExprKind::Rational && expr_number_sign(a) == 0;
-             })) {
+             std::any_of(args.begin(), args.end(), expr_is_exact_zero)) {
     d = 1; // written 0.0, as (expt u 0) is written 1.0 (emit_c.cpp)
   } else if (expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), &n)) {
     double base = degree(args[0], constant_only, memo);

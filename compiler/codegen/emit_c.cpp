@@ -72,20 +72,16 @@ bool integer_power(ExprId id, int64_t *n) {
   return expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), n);
 }
 
-bool is_exact_zero(ExprId id) {
-  return expr_kind(id) == ExprKind::Rational && number_value(id) == 0;
-}
-
 // A node that inline_form writes as a constant without its arguments:
 // (expt u 0) is 1.0 and a product with an exact 0 is 0.0. Its arguments are
 // not collected, so that none gets a name it would never use (fuzz emit-2:
 // a chain of powers under an (expt ... 0) left `const double t33` unread,
 // which -Wall -Werror rejects).
 bool is_constant_form(ExprId id) {
-  if (expr_is_apply(id, Op::Expt)) return is_exact_zero(expr_arg(id, 1));
+  if (expr_is_apply(id, Op::Expt)) return expr_is_exact_zero(expr_arg(id, 1));
   if (!expr_is_apply(id, Op::Mul)) return false;
   for (ExprId a : expr_arg_vector(id))
-    if (is_exact_zero(a)) return true;
+    if (expr_is_exact_zero(a)) return true;
   return false;
 }
 
@@ -268,7 +264,7 @@ private:
     // MIT ((* 0 x) is 0 for a flonum x, even an infinite one); in C,
     // -1.0 * 0.0 is -0., which atan2 and 1/x tell from 0 (fuzz emit-5).
     for (ExprId a : args)
-      if (is_exact_zero(a)) return literal(0.0); // see is_constant_form
+      if (expr_is_exact_zero(a)) return literal(0.0); // see is_constant_form
     if (expr_is_number(args[0]) && number_value(args[0]) == -1.0 && args.size() > 1) {
       std::vector<Code> rest;
       for (size_t i = 1; i < args.size(); ++i)
