@@ -75,6 +75,12 @@ constexpr size_t kMaxTrigAngles = 4;
 // fuzz/crashes-found/README.md: cos(1/3) to the 12,800th took gigabytes).
 // No identity needs more: a form that the rewrite shortens has low degree.
 constexpr long kMaxTrigDegree = 64;
+// exp of a sum becomes the product of the exps of its terms, each a new
+// variable of the rational function, and every operation on a monomial
+// costs the number of variables: exp of a 20,351-term sum took 24 s
+// (emit-9 in fuzz/crashes-found/README.md). exp of a longer sum than this
+// stays as it is; the cancellations the rule is for involve short sums.
+constexpr size_t kMaxExpSumTerms = 64;
 
 std::vector<ExprId> g_memo; // id -> canonical form, kNoExpr when not known yet
 
@@ -183,23 +189,24 @@ bool is_op1(ExprId x, Op op) {
   return expr_is_apply(x, op) && expr_node(x).nargs == 1;
 }
 
-// exp of a sum is the product of the exps of its terms, exp of a negative
-// quantity the reciprocal of exp of its negation, exp of n x with an integer
-// n > 1 a power of (exp x), and exp of n (log y) is y^n: so equal values get
-// one form and products of exponentials cancel ((* (exp x) (exp (- x))) is 1).
+// exp of a sum is the product of the exps of its terms (up to
+// kMaxExpSumTerms of them), exp of a negative quantity the reciprocal of exp
+// of its negation, exp of n x with an integer n > 1 a power of (exp x), and
+// exp of n (log y) is y^n: so equal values get one form and products of
+// exponentials cancel ((* (exp x) (exp (- x))) is 1).
 bool expand_exp(ExprId x, ExprId *out) {
   if (is_op1(x, Op::Log)) {
     *out = expr_arg(x, 0);
     return true;
   }
   std::vector<ExprId> xs = expr_arg_vector(x);
-  if (expr_is_apply(x, Op::Add)) {
+  // A constant term would become a transcendental number; such a sum, and a
+  // long one, stays whole (and may still be negative, below).
+  if (expr_is_apply(x, Op::Add) && xs.size() <= kMaxExpSumTerms &&
+      std::none_of(xs.begin(), xs.end(), expr_is_number)) {
     std::vector<ExprId> factors;
-    for (ExprId term : xs) {
-      // A constant term would become a transcendental number; keep the sum.
-      if (expr_is_number(term)) return false;
+    for (ExprId term : xs)
       factors.push_back(expr_apply(Op::Exp, {term}));
-    }
     *out = simplify_expr(expr_apply(Op::Mul, factors.data(), factors.size()));
     return true;
   }
@@ -387,11 +394,27 @@ public:
     return replace(i, j, e);
   }
 
+  // Built from integer terms over the denominators' lcm and put in order
+  // once: setting the terms one by one re-normalizes the whole polynomial
+  // each time, quadratic in its length (emit-9 spent a minute there).
   Poly to_poly() const {
-    Poly p(ring_);
+    fmpz_t lcm, scaled;
+    fmpz_init_set_ui(lcm, 1);
+    fmpz_init(scaled);
     for (const Term &t : terms_)
-      if (!fmpq_is_zero(t.coeff))
-        fmpq_mpoly_set_coeff_fmpq_ui(p.get(), t.coeff, t.exps.data(), ring_.ctx());
+      if (!fmpq_is_zero(t.coeff)) fmpz_lcm(lcm, lcm, fmpq_denref(t.coeff));
+    Poly p(ring_);
+    for (const Term &t : terms_) {
+      if (fmpq_is_zero(t.coeff)) continue;
+      fmpz_divexact(scaled, lcm, fmpq_denref(t.coeff));
+      fmpz_mul(scaled, scaled, fmpq_numref(t.coeff));
+      fmpq_mpoly_push_term_fmpz_ui(p.get(), scaled, t.exps.data(), ring_.ctx());
+    }
+    fmpq_mpoly_sort_terms(p.get(), ring_.ctx());
+    fmpq_mpoly_combine_like_terms(p.get(), ring_.ctx());
+    fmpq_mpoly_scalar_div_fmpz(p.get(), p.get(), lcm, ring_.ctx());
+    fmpz_clear(scaled);
+    fmpz_clear(lcm);
     return p;
   }
 
@@ -744,10 +767,21 @@ private:
       return std::move(terms[0]);
     }
     case Op::Mul: {
-      RatFun f = convert(args[0]);
-      for (size_t i = 1; i < args.size() && !f.is_zero(); i++)
-        f = rf_mul(f, convert(args[i]));
-      return f;
+      // Multiplied pairwise, as sums are added: multiplying factor by factor
+      // into a growing product is quadratic in the factors, and exp of a
+      // 20,351-term sum is a product of as many powers of exponentials
+      // (emit-9's second input: 34 s). A zero factor ends the product
+      // before the factors after it are converted, as it always did.
+      std::vector<RatFun> factors;
+      factors.reserve(args.size());
+      for (ExprId a : args) {
+        factors.push_back(convert(a));
+        if (factors.back().is_zero()) return std::move(factors.back());
+      }
+      for (size_t width = 1; width < factors.size(); width *= 2)
+        for (size_t i = 0; i + width < factors.size(); i += 2 * width)
+          factors[i] = rf_mul(factors[i], factors[i + width]);
+      return std::move(factors[0]);
     }
     case Op::Div: {
       RatFun d = convert(args[1]);
