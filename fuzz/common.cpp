@@ -229,13 +229,15 @@ Approx NumEval::node(ExprId id) {
       break;
     }
     case Op::Mul: {
-      C p = 1;
-      double e = 0;
-      for (size_t i = 0; i < a.size(); ++i) {
-        double others = 1;
-        for (size_t j = 0; j < a.size(); ++j)
-          if (j != i) others *= std::abs(a[j].v);
-        e += others * a[i].e;
+      // Factor by factor, keeping the product of the errors: |pq - p'q'| <=
+      // |p| e_q + e_p |q| + e_p e_q. The first-order sum alone claims an
+      // exact 0 for the square of a factor known only to be near 0 (a
+      // kernel's 1/cosh^6 overflowed to 0 where the interpreter's was
+      // 5e-309, and the root and square of it differed by 2e-307).
+      C p = a[0].v;
+      double e = a[0].e;
+      for (size_t i = 1; i < a.size(); ++i) {
+        e = std::abs(p) * a[i].e + e * std::abs(a[i].v) + e * a[i].e;
         p *= a[i].v;
       }
       r = {p, e + a.size() * 2 * kU * std::abs(p)};
@@ -269,7 +271,11 @@ Approx NumEval::node(ExprId id) {
       // value whose derivative 1 + tan^2 hides the argument's error.
       if (expr_get_int64(ids[1], &k)) {
         C v = power(x, k);
-        C d = k == 0 ? C(0) : static_cast<double>(k) * power(x, k - 1);
+        // For k > 1 the largest derivative on the argument's interval
+        // (mean value theorem), not the one at x: near 0 that is 0.
+        C d = k == 0   ? C(0)
+              : k > 1 ? static_cast<double>(k) * power(std::abs(x) + a[0].e, k - 1)
+                      : static_cast<double>(k) * power(x, k - 1);
         double steps = 2 * (1 + std::log2(1 + std::fabs(static_cast<double>(k))));
         r = {v, std::abs(d) * a[0].e + steps * kU * std::abs(v)};
       } else {
