@@ -320,6 +320,19 @@ Approx NumEval::node(ExprId id) {
     case Op::Tan: {
       C t = std::tan(x);
       r = unary(t, 1.0 + t * t, a[0]);
+      // Not first order either: tan of an argument known to e lies between
+      // the tangents of x - e and x + e, unless a pole lies between them,
+      // where it may be anything (tan of tan of tan of x0^5, the argument
+      // 1e8 off, claimed 1e191 for values 1e107 and 1e246 apart).
+      if (x.imag() == 0 && a[0].e > 0) {
+        double lo = x.real() - a[0].e, hi = x.real() + a[0].e;
+        if (std::floor(lo / M_PI - 0.5) != std::floor(hi / M_PI - 0.5)) {
+          r.e = INFINITY;
+        } else {
+          for (double end : {lo, hi})
+            r.e = std::max(r.e, std::fabs(std::tan(end) - t.real()) + 2 * kU * std::abs(t));
+        }
+      }
       break;
     }
     case Op::Asin: r = unary(std::asin(x), C(1) / std::sqrt(1.0 - x * x), a[0]); break;

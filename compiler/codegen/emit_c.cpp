@@ -72,26 +72,9 @@ bool integer_power(ExprId id, int64_t *n) {
   return expr_is_apply(id, Op::Expt) && expr_get_int64(expr_arg(id, 1), n);
 }
 
-// A node that inline_form writes as a constant without its arguments:
-// (expt u 0) is 1.0 and a product with an exact 0 is 0.0. Its arguments are
-// not collected, so that none gets a name it would never use (fuzz emit-2:
-// a chain of powers under an (expt ... 0) left `const double t33` unread,
-// which -Wall -Werror rejects).
-bool is_constant_form(ExprId id) {
-  if (expr_is_apply(id, Op::Expt)) return expr_is_exact_zero(expr_arg(id, 1));
-  if (!expr_is_apply(id, Op::Mul)) return false;
-  for (ExprId a : expr_arg_vector(id))
-    if (expr_is_exact_zero(a)) return true;
-  return false;
-}
-
-// A number < 0, or a product whose leading coefficient is: such a term
-// is written subtracted.
-bool negative_term(ExprId id) {
-  if (expr_is_number(id)) return number_value(id) < 0;
-  if (!expr_is_apply(id, Op::Mul) || is_constant_form(id)) return false;
-  ExprId c = expr_arg(id, 0);
-  return expr_is_number(c) && number_value(c) < 0;
+// (expt u 0), which inline_form writes as 1.0 without its argument.
+bool is_zeroth_power(ExprId id) {
+  return expr_is_apply(id, Op::Expt) && expr_is_exact_zero(expr_arg(id, 1));
 }
 
 class Emitter {
@@ -102,6 +85,7 @@ public:
           std::string temp_prefix = "t")
       : outputs_(std::move(outputs)), spell_(std::move(spell)),
         temp_prefix_(std::move(temp_prefix)) {
+    find_exact_zeros();
     collect();
     plan();
   }
@@ -125,6 +109,66 @@ public:
   }
 
 private:
+  // The nodes whose value generic arithmetic gives as the exact 0 whatever
+  // the inputs: an exact 0 times anything (even an infinite flonum, as in
+  // MIT Scheme), and the exact 0 through the functions that keep it
+  // exact ((sin 0), (atan 0 0), (expt 0 3) and (/ 0 x) are the exact 0).
+  // C would compute some of them as -0. ((* -1 (* 0 x)) is -(0.0)), which
+  // atan2 and 1/x tell from 0 (fuzz emit-5 and emit-11). The arena gives
+  // an argument a smaller id than its user, so one pass in id order sees
+  // every argument first.
+  void find_exact_zeros() {
+    std::vector<ExprId> all;
+    std::unordered_set<ExprId> seen;
+    std::vector<ExprId> stack(outputs_.begin(), outputs_.end());
+    while (!stack.empty()) {
+      ExprId id = stack.back();
+      stack.pop_back();
+      if (!seen.insert(id).second || expr_kind(id) != ExprKind::Apply) continue;
+      all.push_back(id);
+      const ExprId *args = expr_args(id);
+      stack.insert(stack.end(), args, args + expr_node(id).nargs);
+    }
+    std::sort(all.begin(), all.end());
+    auto zero = [&](ExprId a) { return expr_is_exact_zero(a) || zeros_.count(a) > 0; };
+    for (ExprId id : all) {
+      std::vector<ExprId> args = expr_arg_vector(id);
+      bool any = std::any_of(args.begin(), args.end(), zero);
+      bool every = std::all_of(args.begin(), args.end(), zero);
+      int64_t n;
+      bool is_zero = false;
+      switch (expr_node(id).op) {
+      case Op::Mul: is_zero = any; break;
+      case Op::Add:
+      case Op::Sin:
+      case Op::Tan:
+      case Op::Asin:
+      case Op::Atan:
+      case Op::Sqrt:
+      case Op::Abs: is_zero = every; break;
+      case Op::Div: is_zero = args.size() == 2 && zero(args[0]); break;
+      case Op::Expt: is_zero = zero(args[0]) && integer_power(id, &n) && n > 0; break;
+      default: break;
+      }
+      if (is_zero) zeros_.insert(id);
+    }
+  }
+
+  // A node written as a constant without its arguments (1.0 or 0.0):
+  // its arguments are not collected, so that none gets a name it would
+  // never use (fuzz emit-2: a chain of powers under an (expt ... 0) left
+  // `const double t33` unread, which -Wall -Werror rejects).
+  bool is_constant_form(ExprId id) const { return is_zeroth_power(id) || zeros_.count(id) > 0; }
+
+  // A number < 0, or a product whose leading coefficient is: such a term
+  // is written subtracted.
+  bool negative_term(ExprId id) const {
+    if (expr_is_number(id)) return number_value(id) < 0;
+    if (!expr_is_apply(id, Op::Mul) || is_constant_form(id)) return false;
+    ExprId c = expr_arg(id, 0);
+    return expr_is_number(c) && number_value(c) < 0;
+  }
+
   // The nodes reachable from the outputs, in increasing id order, and how
   // many times each is used (as an argument of a reachable node or as an
   // output).
@@ -159,7 +203,7 @@ private:
   void plan() {
     std::unordered_map<ExprId, ExprId> sin_of, cos_of; // argument -> node
     for (ExprId id : nodes_) {
-      if (expr_kind(id) != ExprKind::Apply) continue;
+      if (expr_kind(id) != ExprKind::Apply || is_constant_form(id)) continue;
       if (uses_[id] >= 2) wants_name_.insert(id);
       int64_t n;
       if (integer_power(id, &n) && (n >= 2 || n <= -2)) want_operand(expr_arg(id, 0));
@@ -260,11 +304,6 @@ private:
   }
 
   Code mul(const std::vector<ExprId> &args) {
-    // An exact 0 makes the product the exact 0 in generic arithmetic, as in
-    // MIT ((* 0 x) is 0 for a flonum x, even an infinite one); in C,
-    // -1.0 * 0.0 is -0., which atan2 and 1/x tell from 0 (fuzz emit-5).
-    for (ExprId a : args)
-      if (expr_is_exact_zero(a)) return literal(0.0); // see is_constant_form
     if (expr_is_number(args[0]) && number_value(args[0]) == -1.0 && args.size() > 1) {
       std::vector<Code> rest;
       for (size_t i = 1; i < args.size(); ++i)
@@ -336,6 +375,7 @@ private:
 
   // An operation node written out in full (its arguments by ref).
   Code inline_form(ExprId id) {
+    if (zeros_.count(id)) return literal(0.0); // see find_exact_zeros
     Op op = expr_node(id).op;
     std::vector<ExprId> args = expr_arg_vector(id);
     switch (op) {
@@ -386,6 +426,7 @@ private:
   std::vector<ExprId> nodes_; // reachable from the outputs, increasing ids
   std::unordered_map<ExprId, uint32_t> uses_;
   std::unordered_set<ExprId> wants_name_;
+  std::unordered_set<ExprId> zeros_; // see find_exact_zeros
   std::unordered_map<ExprId, ExprId> partner_; // sin node <-> cos node of one argument
   std::unordered_map<ExprId, std::string> name_;
   std::map<std::pair<ExprId, uint64_t>, std::string> powers_; // (base, m) -> a name of base^m

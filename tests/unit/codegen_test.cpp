@@ -345,6 +345,25 @@ TEST(Codegen, ProductWithAnExactZeroIsZero) {
   EXPECT_NE(c.find("atan2(0.0, in[0])"), std::string::npos) << c;
 }
 
+// The exact 0 also reaches through the products and functions that keep
+// it exact in generic arithmetic: (* -1 (* x 0)) is 0, not -(0.0), and
+// sqrt of atan2 of two such zeros is 0, not sqrt(-pi) (fuzz emit-11).
+TEST(Codegen, ExactZeroGoesThroughNegationAndFunctions) {
+  Symbol *x = make_uninterned_symbol("x0").symbol();
+  ExprId x0 = expr_symbol(x);
+  ExprId zero = expr_apply(Op::Mul, {x0, expr_integer(0)});
+  ExprId negated = expr_apply(Op::Mul, {expr_integer(-1), zero});
+  ExprId root = expr_apply(Op::Sqrt, {expr_apply(Op::Atan, {negated, negated})});
+  ExprId cube = expr_apply(Op::Expt, {expr_apply(Op::Sin, {negated}), expr_integer(3)});
+  ExprId out = expr_apply(Op::Add, {x0, expr_apply(Op::Atan, {cube, x0}), root});
+  std::string c = emit_c_assignments({out}, {"out[0]"}, [](Symbol *) { return "in[0]"; }, "t", "");
+  EXPECT_EQ(c.find("-0.0"), std::string::npos) << c;
+  EXPECT_EQ(c.find("-("), std::string::npos) << c;
+  EXPECT_EQ(c.find("sqrt"), std::string::npos) << c;
+  EXPECT_EQ(c.find("sin"), std::string::npos) << c;
+  EXPECT_NE(c.find("atan2(0.0, in[0])"), std::string::npos) << c;
+}
+
 // (expt u 0) is written 1.0 and a product with an exact 0 is 0.0, without
 // their arguments, so nothing under them may get a temporary: a power chain
 // under (expt ... 0) left `const double t33` unread, which -Wall -Werror
