@@ -3,7 +3,7 @@
 // The outputs of a trace form a DAG in the expression arena, already shared
 // by hash-consing. The emitter walks the nodes reachable from the outputs in
 // increasing id order, which is topological (children have smaller ids), and
-// gives a name (a `const double tN`) to every operation node that is used
+// gives a name (a `double tN`) to every operation node that is used
 // more than once, and to a few more that must be simple operands:
 //   - the base of an integer power, written as repeated products (x*x*x);
 //   - the argument of a sin and cos pair, computed by one sincos() call.
@@ -15,6 +15,14 @@
 // magnitude 4 to kMaxSquaringPower are computed by repeated squaring into
 // temporaries, larger ones by pow; negative integer powers are 1.0 divided
 // by the positive power.
+//
+// Temporaries are plain `double`, not `const double`: when optimizing,
+// gcc's C front end substitutes a const local's initializer wherever the
+// local is read, and an initializer it may not fold (1.0 / 0.0, or a
+// product that overflows, under the default -ftrapping-math) then grows
+// as a tree that doubles with each squaring: thirty squarings of such a
+// constant kept gcc -O2 busy for minutes and gigabytes (fuzz emit-1,
+// emit-14). In SSA form the two spellings compile to the same code.
 //
 // Numbers are emitted as the double they round to (exact rationals correctly
 // rounded), in the shortest form that reads back exactly. No user text
@@ -157,7 +165,7 @@ private:
   // A node written as a constant without its arguments (1.0 or 0.0):
   // its arguments are not collected, so that none gets a name it would
   // never use (fuzz emit-2: a chain of powers under an (expt ... 0) left
-  // `const double t33` unread, which -Wall -Werror rejects).
+  // `double t33` unread, which -Wall -Werror rejects).
   bool is_constant_form(ExprId id) const { return is_zeroth_power(id) || zeros_.count(id) > 0; }
 
   // A number < 0, or a product whose leading coefficient is: such a term
@@ -247,7 +255,7 @@ private:
       return;
     }
     std::string t = temp();
-    body_ += "  const double " + t + " = " + c.text + ";\n";
+    body_ += "  double " + t + " = " + c.text + ";\n";
     name_[id] = t;
     int64_t n;
     if (integer_power(id, &n) && n >= 2) powers_[{expr_arg(id, 0), static_cast<uint64_t>(n)}] = t;
@@ -342,7 +350,7 @@ private:
       auto s = powers_.find({base, e});
       if (s == powers_.end()) {
         std::string t = temp();
-        body_ += "  const double " + t + " = " + square + " * " + square + ";\n";
+        body_ += "  double " + t + " = " + square + " * " + square + ";\n";
         s = powers_.emplace(std::make_pair(base, e), t).first;
       }
       square = s->second;

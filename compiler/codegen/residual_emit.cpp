@@ -232,8 +232,11 @@ private:
     }
   }
 
+  // Locals computed from expressions are plain `double`: gcc would paste
+  // a const one's unfoldable constant initializer into every use (see
+  // emit_c.cpp).
   std::string decl(int f, int v) {
-    return hoisted_[f].count(v) ? var_name(v) : "const double " + var_name(v);
+    return hoisted_[f].count(v) ? var_name(v) : "double " + var_name(v);
   }
 
   bool is_ancestor(int a, int f) {
@@ -276,7 +279,7 @@ private:
     std::vector<std::string> names, targets;
     for (size_t i = 0; i < exprs.size(); ++i) {
       names.push_back(prefix + "a" + std::to_string(i));
-      targets.push_back("const double " + names.back());
+      targets.push_back("double " + names.back());
     }
     code += emit_c_assignments(
         exprs, targets, [this](Symbol *s) { return spell(s); }, prefix + "t", "");
