@@ -465,9 +465,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   // A quotient with flonum coefficients (here or inside a kernel such as
   // (sqrt (/ ...))) is not a fixed point (known bug:
   // fuzz/crashes-found/README.md, simplify-1), so it is left out of this
-  // check and the next.
-  // A form with a flonum coefficient of 1., as in (* 1. x), is not one
-  // either (simplify-5); so no form with a flonum is checked here.
+  // check and the next: no form with a flonum is checked here.
   bool flonum = has_flonum(s);
   // Nor is a form with nested square roots always (simplify-4): it is left
   // out of this check and the next too.

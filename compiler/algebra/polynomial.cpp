@@ -499,9 +499,16 @@ ExprId poly_to_expr(const Poly &p, const fmpq_t scale, bool inexact) {
       terms.push_back(coefficient_expr(c, inexact));
       continue;
     }
-    bool one = fmpq_is_one(c);
-    bool minus_one = fmpz_equal_si(fmpq_numref(c), -1) && fmpz_is_one(fmpq_denref(c));
-    if (!one) factors.insert(factors.begin(), coefficient_expr(c, inexact && !minus_one));
+    // A coefficient is 1 or -1 as written: an inexact one that rounds to
+    // 1. is left out as the exact 1 is (and -1. is the exact -1), so that
+    // the result is a fixed point (fuzz simplify-5: five times .2 is
+    // 1.0000000000000000555 exactly, written 1., which a second pass dropped).
+    ExprId coef = coefficient_expr(c, inexact);
+    bool one = fmpq_is_one(c) || (inexact && expr_node(coef).d == 1.0);
+    bool minus_one = (fmpz_equal_si(fmpq_numref(c), -1) && fmpz_is_one(fmpq_denref(c))) ||
+                     (inexact && expr_node(coef).d == -1.0);
+    if (minus_one) coef = expr_integer(-1);
+    if (!one) factors.insert(factors.begin(), coef);
     terms.push_back(factors.size() == 1 ? factors[0]
                                         : expr_apply(Op::Mul, factors.data(), factors.size()));
   }
