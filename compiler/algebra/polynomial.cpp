@@ -519,6 +519,40 @@ ExprId poly_to_expr(const Poly &p, const fmpq_t scale, bool inexact) {
   return expr_apply(Op::Add, terms.data(), terms.size());
 }
 
+// Does every coefficient of p scaled by `scale` round to a finite, nonzero
+// double?
+bool scaled_coefficients_fit(const Poly &p, const fmpq_t scale) {
+  fmpq_t c;
+  fmpq_init(c);
+  mpq_t q;
+  mpq_init(q);
+  bool fit = true;
+  for (slong i = 0; fit && i < p.length(); i++) {
+    fmpq_mpoly_get_term_coeff_fmpq(c, p.get(), i, p.ring().ctx());
+    fmpq_mul(c, c, scale);
+    fmpq_get_mpq(q, c);
+    double d = mpq_get_d(q);
+    fit = d != 0 && std::isfinite(d);
+  }
+  mpq_clear(q);
+  fmpq_clear(c);
+  return fit;
+}
+
+// Sets scale to 1 / (den's leading coefficient) if, so scaled, every
+// coefficient of den and num is a finite nonzero double; otherwise (a
+// coefficient under- or overflows) returns false and leaves scale alone.
+bool monic_scale(const Poly &den, const Poly &num, fmpq_t scale) {
+  fmpq_t lead;
+  fmpq_init(lead);
+  fmpq_mpoly_get_term_coeff_fmpq(lead, den.get(), 0, den.ring().ctx());
+  fmpq_inv(lead, lead);
+  bool fit = scaled_coefficients_fit(den, lead) && scaled_coefficients_fit(num, lead);
+  if (fit) fmpq_set(scale, lead);
+  fmpq_clear(lead);
+  return fit;
+}
+
 } // namespace
 
 ExprId rf_to_expr(const RatFun &f, bool inexact) {
@@ -536,6 +570,14 @@ ExprId rf_to_expr(const RatFun &f, bool inexact) {
     // into the numerator, as scmutils' divide-numbers-through leaves them.
     num = poly_to_expr(f.num, scale, inexact);
     den = poly_to_expr(f.den, scale, false);
+  } else if (inexact && monic_scale(f.den, f.num, scale)) {
+    // Flonum coefficients: the denominator is made monic (its leading
+    // term's coefficient 1, which rounding leaves alone), as scmutils
+    // writes (/ 1 (+ x .6)). Made integers, as exact ones are below, they
+    // were scaled by the exact denominators of the flonums (2^52 and its
+    // powers), and by different ones when simplified again (fuzz simplify-1).
+    num = poly_to_expr(f.num, scale, inexact);
+    den = poly_to_expr(f.den, scale, inexact);
   } else {
     // FLINT keeps a polynomial as content * primitive integer polynomial with
     // a positive leading coefficient. With r = content(num)/content(den) = p/q
