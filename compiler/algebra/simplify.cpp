@@ -798,7 +798,10 @@ private:
       // an error, u^1 would not be.
       ExprId base = args[0];
       int64_t inner, product, combined = e;
-      while (combined != 0 && expr_is_apply(base, Op::Expt) &&
+      // Only through polynomial powers: a power past kMaxExpandedPower is
+      // a variable of the ring, its base not (emit-17: (expt (expt x
+      // 200000) -9) reached a base collect had not seen, and aborted).
+      while (combined != 0 && expr_is_polynomial_power(base) &&
              expr_get_int64(expr_arg(base, 1), &inner) && inner != 0 &&
              !__builtin_mul_overflow(combined, inner, &product)) {
         combined = product;
