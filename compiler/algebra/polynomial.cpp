@@ -465,11 +465,22 @@ RatFun rf_reduce_square(const RatFun &f, int v, const RatFun &square) {
 
 namespace {
 
-ExprId coefficient_expr(const fmpq_t c, bool inexact) {
+// The flonum a coefficient is written as (GMP's conversion, as before).
+double coefficient_double(const fmpq_t c) {
   mpq_t q;
   mpq_init(q);
   fmpq_get_mpq(q, c);
-  ExprId e = inexact ? expr_flonum(mpq_get_d(q)) : expr_rational(q);
+  double d = mpq_get_d(q);
+  mpq_clear(q);
+  return d;
+}
+
+ExprId coefficient_expr(const fmpq_t c, bool inexact) {
+  if (inexact) return expr_flonum(coefficient_double(c));
+  mpq_t q;
+  mpq_init(q);
+  fmpq_get_mpq(q, c);
+  ExprId e = expr_rational(q);
   mpq_clear(q);
   return e;
 }
@@ -524,17 +535,13 @@ ExprId poly_to_expr(const Poly &p, const fmpq_t scale, bool inexact) {
 bool scaled_coefficients_fit(const Poly &p, const fmpq_t scale) {
   fmpq_t c;
   fmpq_init(c);
-  mpq_t q;
-  mpq_init(q);
   bool fit = true;
   for (slong i = 0; fit && i < p.length(); i++) {
     fmpq_mpoly_get_term_coeff_fmpq(c, p.get(), i, p.ring().ctx());
     fmpq_mul(c, c, scale);
-    fmpq_get_mpq(q, c);
-    double d = mpq_get_d(q);
+    double d = coefficient_double(c);
     fit = d != 0 && std::isfinite(d);
   }
-  mpq_clear(q);
   fmpq_clear(c);
   return fit;
 }
