@@ -37,11 +37,14 @@
 #include <cstring>
 #include <functional>
 #include <map>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
+#include "algebra/symbolic.hpp"
 #include "codegen/jit.hpp"
 #include "eval/number.hpp"
+#include "syntax/error.hpp"
 #include "sicm/runtime.h"
 
 namespace sicm {
@@ -139,8 +142,14 @@ private:
     }
     std::sort(all.begin(), all.end());
     auto zero = [&](ExprId a) { return expr_is_exact_zero(a) || zeros_.count(a) > 0; };
+    ConstantValues constants; // see constant_value
     for (ExprId id : all) {
       std::vector<ExprId> args = expr_arg_vector(id);
+      if (std::optional<Value> v = constant_value(id, args, constants)) {
+        constants.emplace(id, *v);
+        if (is_exact(*v) && num_is_zero(*v)) zeros_.insert(id);
+        continue;
+      }
       bool any = std::any_of(args.begin(), args.end(), zero);
       bool every = std::all_of(args.begin(), args.end(), zero);
       int64_t n;
@@ -159,6 +168,59 @@ private:
       default: break;
       }
       if (is_zero) zeros_.insert(id);
+    }
+  }
+
+  // Values of constant nodes; gc_allocator keeps their boxes alive.
+  using ConstantValues = std::unordered_map<ExprId, Value, std::hash<ExprId>, std::equal_to<ExprId>,
+                                            gc_allocator<std::pair<const ExprId, Value>>>;
+
+  // The value generic arithmetic gives a node of constants only, which
+  // nobody folded ((atan 0 (expt 3 -6)) is the exact 0, and so its product
+  // with a NaN: emit run H), given its arguments' values in constants;
+  // nullopt if an argument is not constant, if generic arithmetic raises
+  // or leaves an expression, or if an exact argument or result is larger
+  // than kMaxConstantBits (such a node is left to C, as before).
+  static std::optional<Value> constant_value(ExprId id, const std::vector<ExprId> &args,
+                                             const ConstantValues &constants) {
+    constexpr size_t kMaxConstantBits = 256;
+    auto small = [](Value v) {
+      if (!is_exact(v)) return true;
+      mpq_t q;
+      mpq_init(q);
+      to_mpq(v, q);
+      bool fits = mpz_sizeinbase(mpq_numref(q), 2) + mpz_sizeinbase(mpq_denref(q), 2) <=
+                  kMaxConstantBits;
+      mpq_clear(q);
+      return fits;
+    };
+    gcvec<Value> values;
+    for (ExprId a : args) {
+      ExprKind kind = expr_kind(a);
+      if (kind == ExprKind::Rational || kind == ExprKind::Flonum) {
+        values.push_back(expr_number_value(a));
+      } else if (auto it = constants.find(a); it != constants.end()) {
+        values.push_back(it->second);
+      } else {
+        return std::nullopt;
+      }
+      if (!small(values.back())) return std::nullopt;
+    }
+    Op op = expr_node(id).op;
+    // An exact power's size is its base's times the exponent: bound it
+    // before computing it.
+    if (op == Op::Expt && is_exact(values[0]) && is_exact_integer(values[1])) {
+      std::optional<int64_t> n = to_int64(values[1]);
+      if (!n || *n > static_cast<int64_t>(kMaxConstantBits) ||
+          *n < -static_cast<int64_t>(kMaxConstantBits))
+        return std::nullopt;
+    }
+    try {
+      Value v = symbolic_apply(op, values.data(), static_cast<int>(values.size()));
+      if (!is_number(v) || !small(v)) return std::nullopt;
+      return v;
+    } catch (const Error &) {
+      return std::nullopt;
     }
   }
 

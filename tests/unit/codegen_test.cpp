@@ -364,6 +364,28 @@ TEST(Codegen, ExactZeroGoesThroughNegationAndFunctions) {
   EXPECT_NE(c.find("atan2(0.0, in[0])"), std::string::npos) << c;
 }
 
+// A node of constants that nobody folded has the value generic arithmetic
+// gives it: (atan 0 (expt 3 -6)) and (+ 1 -1) are the exact 0, so their
+// products are 0.0 even with a factor that is NaN in C (the root of a
+// negative; emit run H). (atan 0 (expt -3 -5)) is pi, not 0.
+TEST(Codegen, ConstantNodesHaveTheirGenericValue) {
+  Symbol *x = make_uninterned_symbol("x0").symbol();
+  ExprId root = expr_apply(Op::Sqrt, {expr_symbol(x)});
+  ExprId atan_zero =
+      expr_apply(Op::Atan, {expr_integer(0), expr_apply(Op::Expt, {expr_integer(3), expr_integer(-6)})});
+  ExprId sum_zero = expr_apply(Op::Add, {expr_integer(1), expr_integer(-1)});
+  ExprId atan_pi =
+      expr_apply(Op::Atan, {expr_integer(0), expr_apply(Op::Expt, {expr_integer(-3), expr_integer(-5)})});
+  ExprId outs[] = {expr_apply(Op::Mul, {root, atan_zero}), expr_apply(Op::Mul, {sum_zero, root}),
+                   expr_apply(Op::Mul, {root, atan_pi})};
+  std::string c = emit_c_assignments({outs[0], outs[1], outs[2]}, {"out[0]", "out[1]", "out[2]"},
+                                     [](Symbol *) { return "in[0]"; }, "t", "");
+  EXPECT_NE(c.find("out[0] = 0.0;"), std::string::npos) << c;
+  EXPECT_NE(c.find("out[1] = 0.0;"), std::string::npos) << c;
+  EXPECT_EQ(c.find("out[2] = 0.0;"), std::string::npos) << c;
+  EXPECT_NE(c.find("atan2"), std::string::npos) << c;
+}
+
 // (expt u 0) is written 1.0 and a product with an exact 0 is 0.0, without
 // their arguments, so nothing under them may get a temporary: a power chain
 // under (expt ... 0) left `double t33` unread, which -Wall -Werror
