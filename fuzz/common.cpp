@@ -216,6 +216,15 @@ Approx NumEval::node(ExprId id) {
         ((n.op == Op::Sqrt || n.op == Op::Log) && near_singular(a[0])) ||
         (n.op == Op::Expt && !(expr_get_int64(ids[1], &k0) && k0 >= 0) && near_singular(a[0]));
     if (singular_arg) degenerate_ = true;
+    // The argument's real interval [v - e, v + e] against the domain's
+    // edge: 0 for sqrt, log and fractional powers, -1 and 1 for asin, acos.
+    auto crosses = [](const Approx &t, double edge) {
+      return t.v.imag() == 0 && t.v.real() - t.e <= edge && edge <= t.v.real() + t.e;
+    };
+    bool at_edge =
+        ((n.op == Op::Sqrt || n.op == Op::Log) && crosses(a[0], 0)) ||
+        (n.op == Op::Expt && !expr_get_int64(ids[1], &k0) && crosses(a[0], 0)) ||
+        ((n.op == Op::Asin || n.op == Op::Acos) && (crosses(a[0], -1) || crosses(a[0], 1)));
     switch (n.op) {
     case Op::Add: {
       C s = 0;
@@ -386,6 +395,7 @@ Approx NumEval::node(ExprId id) {
     // * y), whose y^4 overflowed. A root then makes either a normal number
     // (1e-158 against 0). Such a value is known to DBL_MIN.
     if (std::abs(r.v) < DBL_MIN) r.e = std::max(r.e, DBL_MIN);
+    r.edge = at_edge || std::any_of(a.begin(), a.end(), [](const Approx &t) { return t.edge; });
     break;
   }
   }

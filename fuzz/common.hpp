@@ -98,6 +98,12 @@ uint64_t hash_bytes(const uint8_t *data, size_t size);
 struct Approx {
   std::complex<double> v;
   double e = 0;
+  // Some operator on the way (sqrt, log, a power that is not an integer,
+  // asin, acos) had a real argument whose interval reaches past the edge of
+  // its real domain: a correct evaluation may round to the other side and
+  // give NaN where the interpreter has a value (an expanded polynomial
+  // 1.6e-21, known to 6e-18, to the 5/2: emit run H).
+  bool edge = false;
 };
 
 class NumEval {

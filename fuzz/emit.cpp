@@ -27,7 +27,9 @@
 //      left there. A point where the interpreter raises
 //      (sqrt or log of a negative: sicm has no complex numbers, a division
 //      by an exact zero) or where any value or bound is not finite is
-//      skipped.
+//      skipped, and so is a NaN from the kernel where the argument of a
+//      root, log, fractional power, asin or acos is known only to an
+//      interval that reaches past the edge of its domain.
 //   3. the C compiler finishes within kCompileSeconds (a kernel that makes
 //      it run for minutes is a bug: emit-1).
 // Starting the C compiler costs about 70 ms, so the kernels are compiled in
@@ -433,7 +435,10 @@ void check_kernel(const Pending &k, KernelFn fn) {
       // A bound as large as the value says nothing is known of it: then a
       // NaN from the kernel (sqrt or acos of tan of 1e44, whose argument
       // rounded to the other side of the domain's edge) is no finding.
-      bool unknown = std::isnan(got) && kBoundFactor * bound.e >= std::fabs(want);
+      // So is a NaN where an argument's interval reached past its domain's
+      // edge (Approx::edge): the C rounded to the other side of it.
+      bool unknown =
+          std::isnan(got) && (bound.edge || kBoundFactor * bound.e >= std::fabs(want));
       if (std::isfinite(want) &&
           (relative || both_tiny || unknown || diff <= kBoundFactor * bound.e)) {
         ++g_stats.compared;
