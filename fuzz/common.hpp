@@ -102,7 +102,8 @@ struct Approx {
   // asin, acos) had a real argument whose interval reaches past the edge of
   // its real domain: a correct evaluation may round to the other side and
   // give NaN where the interpreter has a value (an expanded polynomial
-  // 1.6e-21, known to 6e-18, to the 5/2: emit run H).
+  // worth 1.6e-21, whose largest term's last bit is 3.4e-21, to the 5/2:
+  // emit run H).
   bool edge = false;
 };
 
