@@ -465,24 +465,27 @@ RatFun rf_reduce_square(const RatFun &f, int v, const RatFun &square) {
 
 namespace {
 
+// A coefficient as a GMP rational, for the two conversions written with GMP
+// (to a double, to the arena), freed at the end of the full expression.
+struct GmpRational {
+  mpq_t q;
+  explicit GmpRational(const fmpq_t c) {
+    mpq_init(q);
+    fmpq_get_mpq(q, c);
+  }
+  ~GmpRational() { mpq_clear(q); }
+  GmpRational(const GmpRational &) = delete;
+  GmpRational &operator=(const GmpRational &) = delete;
+};
+
 // The flonum a coefficient is written as (GMP's conversion, as before).
 double coefficient_double(const fmpq_t c) {
-  mpq_t q;
-  mpq_init(q);
-  fmpq_get_mpq(q, c);
-  double d = mpq_get_d(q);
-  mpq_clear(q);
-  return d;
+  return mpq_get_d(GmpRational(c).q);
 }
 
 ExprId coefficient_expr(const fmpq_t c, bool inexact) {
   if (inexact) return expr_flonum(coefficient_double(c));
-  mpq_t q;
-  mpq_init(q);
-  fmpq_get_mpq(q, c);
-  ExprId e = expr_rational(q);
-  mpq_clear(q);
-  return e;
+  return expr_rational(GmpRational(c).q);
 }
 
 // The canonical expression of p, its coefficients first multiplied by `scale`.

@@ -194,16 +194,17 @@ private:
       mpq_clear(q);
       return fits;
     };
+    // Most nodes have an input among their arguments: they are turned away
+    // before anything is allocated.
+    auto is_constant = [&](ExprId a) {
+      ExprKind kind = expr_kind(a);
+      return kind == ExprKind::Rational || kind == ExprKind::Flonum || constants.count(a) > 0;
+    };
+    if (!std::all_of(args.begin(), args.end(), is_constant)) return std::nullopt;
     gcvec<Value> values;
     for (ExprId a : args) {
-      ExprKind kind = expr_kind(a);
-      if (kind == ExprKind::Rational || kind == ExprKind::Flonum) {
-        values.push_back(expr_number_value(a));
-      } else if (auto it = constants.find(a); it != constants.end()) {
-        values.push_back(it->second);
-      } else {
-        return std::nullopt;
-      }
+      auto it = constants.find(a);
+      values.push_back(it != constants.end() ? it->second : expr_number_value(a));
       if (!small(values.back())) return std::nullopt;
     }
     Op op = expr_node(id).op;
