@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "algebra/generic.hpp"
+#include "algebra/linear_solve.hpp"
 #include "algebra/symbolic.hpp"
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
@@ -214,6 +216,7 @@ Value integer_power(Value x, Value exponent, BinaryOp op) {
 // (/ a s): a times the inverse of s; an up is solved for on the right of the
 // inverse, as the book writes a column vector.
 Value divide_by_structure(Value a, Value s) {
+  if (std::optional<Value> solved = traced_structure_solve(a, s)) return *solved;
   Value inverse = structure_inverse(s, "/");
   if (is_structure(a) && as_structure(a)->up) return g_mul(inverse, a);
   return g_mul(a, inverse);
@@ -334,6 +337,7 @@ Value matrix_div(Value a, Value b) {
     if (is_structure(b)) shape_mismatch("/", a, b);
     return map_matrix(a, [&](Value x) { return g_div(x, b); });
   }
+  if (std::optional<Value> solved = traced_matrix_solve(a, b)) return *solved;
   Value inverse = matrix_inverse(b, "/");
   if (is_structure(a)) return g_mul(inverse, a);
   return g_mul(a, inverse);

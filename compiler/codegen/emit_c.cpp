@@ -41,11 +41,12 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "algebra/linear_solve.hpp"
 #include "algebra/symbolic.hpp"
 #include "codegen/jit.hpp"
 #include "eval/number.hpp"
-#include "syntax/error.hpp"
 #include "sicm/runtime.h"
+#include "syntax/error.hpp"
 
 namespace sicm {
 
@@ -88,6 +89,21 @@ bool is_zeroth_power(ExprId id) {
   return expr_is_apply(id, Op::Expt) && expr_is_exact_zero(expr_arg(id, 1));
 }
 
+// The nodes a node computes from: an operation's arguments, a solve node's
+// matrix and right-hand side (its component index is not a value); none for
+// numbers, symbols and other calls.
+std::vector<ExprId> operands(ExprId id) {
+  if (expr_kind(id) == ExprKind::Apply) return expr_arg_vector(id);
+  if (!is_solve_node(id)) return {};
+  std::vector<ExprId> v = expr_arg_vector(id);
+  v.erase(v.begin());
+  return v;
+}
+
+bool has_operands(ExprId id) {
+  return expr_kind(id) == ExprKind::Apply || is_solve_node(id);
+}
+
 class Emitter {
 public:
   // spell gives the C text of a symbol (an atom); temporaries are named
@@ -109,6 +125,16 @@ public:
       Code c = ref(outputs_[j]);
       body_ += "  " + targets[j] + " = " + c.text + ";\n";
     }
+    if (!singular_flags_.empty()) {
+      // A singular matrix: every output is the NaN that says so (sicm/error.h).
+      std::string any;
+      for (const std::string &f : singular_flags_)
+        any += (any.empty() ? "" : " | ") + f;
+      body_ += "  if (" + any + ") {\n";
+      for (const std::string &t : targets)
+        body_ += "    " + t + " = sicm_singular_nan();\n";
+      body_ += "  }\n";
+    }
     std::string out;
     size_t start = 0;
     while (start < body_.size()) {
@@ -120,6 +146,11 @@ public:
   }
 
 private:
+  struct Factors {
+    std::string array, pivots; // pivots: LU only
+    bool symmetric = false;
+  };
+
   // The nodes whose value generic arithmetic gives as the exact 0 whatever
   // the inputs: an exact 0 times anything (even an infinite flonum, as in
   // MIT Scheme), and the exact 0 through the functions that keep it
@@ -135,10 +166,10 @@ private:
     while (!stack.empty()) {
       ExprId id = stack.back();
       stack.pop_back();
-      if (!seen.insert(id).second || expr_kind(id) != ExprKind::Apply) continue;
-      all.push_back(id);
-      const ExprId *args = expr_args(id);
-      stack.insert(stack.end(), args, args + expr_node(id).nargs);
+      if (!seen.insert(id).second || !has_operands(id)) continue;
+      if (expr_kind(id) == ExprKind::Apply) all.push_back(id);
+      std::vector<ExprId> args = operands(id);
+      stack.insert(stack.end(), args.begin(), args.end());
     }
     std::sort(all.begin(), all.end());
     auto zero = [&](ExprId a) { return expr_is_exact_zero(a) || zeros_.count(a) > 0; };
@@ -189,8 +220,8 @@ private:
       mpq_t q;
       mpq_init(q);
       to_mpq(v, q);
-      bool fits = mpz_sizeinbase(mpq_numref(q), 2) + mpz_sizeinbase(mpq_denref(q), 2) <=
-                  kMaxConstantBits;
+      bool fits =
+          mpz_sizeinbase(mpq_numref(q), 2) + mpz_sizeinbase(mpq_denref(q), 2) <= kMaxConstantBits;
       mpq_clear(q);
       return fits;
     };
@@ -251,19 +282,27 @@ private:
       stack.pop_back();
       if (!seen.insert(id).second) continue;
       nodes_.push_back(id);
-      if (expr_kind(id) != ExprKind::Apply || is_constant_form(id)) continue;
-      const ExprId *args = expr_args(id);
-      stack.insert(stack.end(), args, args + expr_node(id).nargs);
+      if (!has_operands(id) || is_constant_form(id)) continue;
+      std::vector<ExprId> args = operands(id);
+      stack.insert(stack.end(), args.begin(), args.end());
     }
     std::sort(nodes_.begin(), nodes_.end());
     for (ExprId id : nodes_) {
-      if (expr_kind(id) != ExprKind::Apply || is_constant_form(id)) continue;
-      const ExprId *args = expr_args(id);
-      for (uint32_t i = 0; i < expr_node(id).nargs; ++i)
-        ++uses_[args[i]];
+      if (!has_operands(id) || is_constant_form(id)) continue;
+      for (ExprId a : operands(id))
+        ++uses_[a];
     }
     for (ExprId id : outputs_)
       ++uses_[id];
+  }
+
+  // (* -1 x) of an input x: written in place (a - x in a sum) it costs no
+  // more than a name would, so it gets none even when shared (the pair
+  // differences q_i - q_j of an N-body kernel share each -q_j).
+  static bool is_input_negation(ExprId id) {
+    return expr_is_apply(id, Op::Mul) && expr_node(id).nargs == 2 &&
+           expr_is_number(expr_arg(id, 0)) && number_value(expr_arg(id, 0)) == -1.0 &&
+           expr_kind(expr_arg(id, 1)) == ExprKind::Symbol;
   }
 
   void want_operand(ExprId id) {
@@ -274,8 +313,9 @@ private:
   void plan() {
     std::unordered_map<ExprId, ExprId> sin_of, cos_of; // argument -> node
     for (ExprId id : nodes_) {
+      if (is_solve_node(id)) wants_name_.insert(id);
       if (expr_kind(id) != ExprKind::Apply || is_constant_form(id)) continue;
-      if (uses_[id] >= 2) wants_name_.insert(id);
+      if (uses_[id] >= 2 && !is_input_negation(id)) wants_name_.insert(id);
       int64_t n;
       if (integer_power(id, &n) && (n >= 2 || n <= -2)) want_operand(expr_arg(id, 0));
       if (expr_is_apply(id, Op::Sin)) sin_of[expr_arg(id, 0)] = id;
@@ -301,6 +341,10 @@ private:
   // Give id a name, emitting the statement that computes it. Every node it
   // uses that has a name already has one (smaller ids were handled first).
   void emit_named(ExprId id) {
+    if (is_solve_node(id)) {
+      name_[id] = solution(id) + "[" + std::to_string(solve_component(id)) + "]";
+      return;
+    }
     auto p = partner_.find(id);
     if (p != partner_.end()) {
       ExprId s = expr_is_apply(id, Op::Sin) ? id : p->second;
@@ -324,6 +368,68 @@ private:
     if (integer_power(id, &n) && n >= 2) powers_[{expr_arg(id, 0), static_cast<uint64_t>(n)}] = t;
   }
 
+  // The array that holds the factors of the solve node's matrix, factoring
+  // it on first use: LDL^T when it is symmetric node for node (a mass
+  // matrix), else LU with partial pivoting. Each factorization's flag says
+  // whether the matrix was singular (see assignments).
+  const Factors &factors(ExprId solve) {
+    size_t n = solve_dimension(solve);
+    std::vector<ExprId> key;
+    bool symmetric = true;
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j) {
+        key.push_back(solve_matrix_entry(solve, i, j));
+        symmetric = symmetric && key.back() == solve_matrix_entry(solve, j, i);
+      }
+    auto hit = factors_.find(key);
+    if (hit != factors_.end()) return hit->second;
+    Factors f;
+    f.symmetric = symmetric;
+    f.array = temp();
+    std::string entries;
+    for (size_t k = 0; k < key.size(); ++k)
+      entries += (k ? ", " : "") + ref(key[k]).text;
+    std::string dim = std::to_string(n);
+    body_ += "  double " + f.array + "[" + std::to_string(n * n) + "] = {" + entries + "};\n";
+    std::string flag = f.array + "_singular";
+    if (symmetric) {
+      body_ += "  int " + flag + " = sicm_ldlt_factor(" + dim + ", " + f.array + ");\n";
+    } else {
+      f.pivots = f.array + "_pivots";
+      body_ += "  int " + f.pivots + "[" + dim + "];\n";
+      body_ +=
+          "  int " + flag + " = sicm_lu_factor(" + dim + ", " + f.array + ", " + f.pivots + ");\n";
+    }
+    singular_flags_.push_back(flag);
+    return factors_.emplace(std::move(key), std::move(f)).first->second;
+  }
+
+  // The array that holds the solution of the solve node's system, solved on
+  // first use.
+  std::string solution(ExprId solve) {
+    size_t n = solve_dimension(solve);
+    std::vector<ExprId> key;
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j)
+        key.push_back(solve_matrix_entry(solve, i, j));
+    for (size_t i = 0; i < n; ++i)
+      key.push_back(solve_rhs_entry(solve, i));
+    auto hit = solutions_.find(key);
+    if (hit != solutions_.end()) return hit->second;
+    const Factors &f = factors(solve);
+    std::string x = temp(), rhs;
+    for (size_t i = 0; i < n; ++i)
+      rhs += (i ? ", " : "") + ref(solve_rhs_entry(solve, i)).text;
+    std::string dim = std::to_string(n);
+    body_ += "  double " + x + "[" + dim + "] = {" + rhs + "};\n";
+    if (f.symmetric)
+      body_ += "  sicm_ldlt_solve(" + dim + ", " + f.array + ", " + x + ");\n";
+    else
+      body_ += "  sicm_lu_solve(" + dim + ", " + f.array + ", " + f.pivots + ", " + x + ");\n";
+    solutions_.emplace(std::move(key), x);
+    return x;
+  }
+
   // The node as it appears in an expression of its user.
   Code ref(ExprId id) {
     auto n = name_.find(id);
@@ -334,7 +440,7 @@ private:
     case ExprKind::Flonum: return literal(number_value(id));
     case ExprKind::Symbol: return {spell_(node.sym), kAtom};
     case ExprKind::Apply: return inline_form(id);
-    case ExprKind::Call: break; // trace_procedure refuses Calls
+    case ExprKind::Call: break; // solve nodes are named; trace_procedure refuses other Calls
     }
     internal_failure(__FILE__, __LINE__, "a Call node reached the C emitter");
   }
@@ -374,17 +480,25 @@ private:
     return {s, kAdd};
   }
 
+  // A product; its factors that are negative integer powers (and have no
+  // name of their own) divide: a * b^-2 is a / (b * b), one division and
+  // no reciprocal.
   Code mul(const std::vector<ExprId> &args) {
-    if (expr_is_number(args[0]) && number_value(args[0]) == -1.0 && args.size() > 1) {
-      std::vector<Code> rest;
-      for (size_t i = 1; i < args.size(); ++i)
-        rest.push_back(ref(args[i]));
-      return {"-" + wrap(product(rest), kAtom), kUnary};
+    bool negate = expr_is_number(args[0]) && number_value(args[0]) == -1.0 && args.size() > 1;
+    std::vector<Code> numerator, denominator;
+    for (size_t i = negate ? 1 : 0; i < args.size(); ++i) {
+      int64_t n;
+      if (!name_.count(args[i]) && !is_constant_form(args[i]) && integer_power(args[i], &n) &&
+          n < 0 && n > INT64_MIN && args.size() > 1)
+        denominator.push_back(power(expr_arg(args[i], 0), static_cast<uint64_t>(-n)));
+      else
+        numerator.push_back(ref(args[i]));
     }
-    std::vector<Code> factors;
-    for (ExprId a : args)
-      factors.push_back(ref(a));
-    return product(factors);
+    Code c = numerator.empty() ? Code{"1.0", kAtom} : product(numerator);
+    if (!denominator.empty())
+      c = {wrap(c, kMul) + " / " + wrap(product(denominator), kUnary), kMul};
+    if (negate) return {"-" + wrap(c, kAtom), kUnary};
+    return c;
   }
 
   // base^m for m >= 1: small powers as products, larger ones by repeated
@@ -497,10 +611,13 @@ private:
   std::vector<ExprId> nodes_; // reachable from the outputs, increasing ids
   std::unordered_map<ExprId, uint32_t> uses_;
   std::unordered_set<ExprId> wants_name_;
-  std::unordered_set<ExprId> zeros_; // see find_exact_zeros
+  std::unordered_set<ExprId> zeros_;           // see find_exact_zeros
   std::unordered_map<ExprId, ExprId> partner_; // sin node <-> cos node of one argument
   std::unordered_map<ExprId, std::string> name_;
   std::map<std::pair<ExprId, uint64_t>, std::string> powers_; // (base, m) -> a name of base^m
+  std::map<std::vector<ExprId>, Factors> factors_;            // matrix entries -> factors
+  std::map<std::vector<ExprId>, std::string> solutions_;      // matrix and rhs -> solution array
+  std::vector<std::string> singular_flags_;
   std::string body_;
   size_t ntemps_ = 0;
 };
@@ -606,12 +723,118 @@ std::string emit_c_assignments(const std::vector<ExprId> &values,
   return Emitter(values, spell, temp_prefix).assignments(targets, indent);
 }
 
+bool uses_linear_solve(const std::vector<ExprId> &outputs) {
+  std::unordered_set<ExprId> seen;
+  std::vector<ExprId> stack(outputs.begin(), outputs.end());
+  while (!stack.empty()) {
+    ExprId id = stack.back();
+    stack.pop_back();
+    if (!seen.insert(id).second || !has_operands(id)) continue;
+    if (is_solve_node(id)) return true;
+    std::vector<ExprId> args = operands(id);
+    stack.insert(stack.end(), args.begin(), args.end());
+  }
+  return false;
+}
+
+// The factorizations are loops over n rather than unrolled code: their
+// cost is O(n^3) flops either way, and loops keep the C of a 24-link chain
+// small. A pivot is taken as zero when it is below kSingularPivot (times
+// n) relative to the matrix's scale: a rank-deficient matrix of doubles
+// leaves pivots of a few ulps, not exact zeros.
+std::string c_linear_solve_support() {
+  char bits[64];
+  std::snprintf(bits, sizeof bits, "0x%llxULL",
+                static_cast<unsigned long long>(SICM_SINGULAR_NAN_BITS));
+  return std::string(R"(/* Linear solves of the kernel (sicm's C emitter). */
+static inline double sicm_singular_nan(void) {
+  union { unsigned long long bits; double d; } u = {)") +
+         bits + R"(};
+  return u.d;
+}
+
+/* a (n x n, row-major, symmetric: only its lower triangle is read) becomes
+   L D L^T in place: L below the diagonal, D on it. Nonzero when a pivot is
+   not positive (a singular or indefinite matrix). */
+static inline int sicm_ldlt_factor(int n, double *a) {
+  int singular = 0;
+  for (int j = 0; j < n; ++j) {
+    double scale = fabs(a[j * n + j]), d = a[j * n + j];
+    for (int k = 0; k < j; ++k) {
+      a[k * n + j] = a[j * n + k] * a[k * n + k]; /* L_jk d_k, kept above the diagonal */
+      d -= a[j * n + k] * a[k * n + j];
+    }
+    if (!(d > 4 * n * 2.220446049250313e-16 * scale)) singular = 1;
+    a[j * n + j] = d;
+    for (int i = j + 1; i < n; ++i) {
+      double s = a[i * n + j];
+      for (int k = 0; k < j; ++k) s -= a[i * n + k] * a[k * n + j];
+      a[i * n + j] = s / d;
+    }
+  }
+  return singular;
+}
+
+static inline void sicm_ldlt_solve(int n, const double *a, double *x) {
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < i; ++k) x[i] -= a[i * n + k] * x[k];
+  for (int i = 0; i < n; ++i) x[i] /= a[i * n + i];
+  for (int i = n - 1; i >= 0; --i)
+    for (int k = i + 1; k < n; ++k) x[i] -= a[k * n + i] * x[k];
+}
+
+/* a becomes L U in place with rows exchanged as pivots[] says (partial
+   pivoting). Nonzero when a pivot is zero to working precision. */
+static inline int sicm_lu_factor(int n, double *a, int *pivots) {
+  int singular = 0;
+  double scale = 0;
+  for (int i = 0; i < n * n; ++i)
+    if (fabs(a[i]) > scale) scale = fabs(a[i]);
+  for (int k = 0; k < n; ++k) {
+    int p = k;
+    for (int i = k + 1; i < n; ++i)
+      if (fabs(a[i * n + k]) > fabs(a[p * n + k])) p = i;
+    pivots[k] = p;
+    if (p != k)
+      for (int j = 0; j < n; ++j) {
+        double t = a[k * n + j];
+        a[k * n + j] = a[p * n + j];
+        a[p * n + j] = t;
+      }
+    if (!(fabs(a[k * n + k]) > 4 * n * 2.220446049250313e-16 * scale)) singular = 1;
+    for (int i = k + 1; i < n; ++i) {
+      double f = a[i * n + k] / a[k * n + k];
+      a[i * n + k] = f;
+      for (int j = k + 1; j < n; ++j) a[i * n + j] -= f * a[k * n + j];
+    }
+  }
+  return singular;
+}
+
+static inline void sicm_lu_solve(int n, const double *a, const int *pivots, double *x) {
+  for (int k = 0; k < n; ++k) {
+    double t = x[k];
+    x[k] = x[pivots[k]];
+    x[pivots[k]] = t;
+  }
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < i; ++k) x[i] -= a[i * n + k] * x[k];
+  for (int i = n - 1; i >= 0; --i) {
+    for (int k = i + 1; k < n; ++k) x[i] -= a[i * n + k] * x[k];
+    x[i] /= a[i * n + i];
+  }
+}
+
+)";
+}
+
 std::string emit_kernel_unit(const Trace &t, const std::string &c_name,
                              std::string_view source_name) {
   std::string s = "/* sicm kernel " + c_sanitize(source_name, 64) + ": " +
                   std::to_string(t.inputs.size()) + " inputs, " + std::to_string(t.outputs.size()) +
                   " outputs. Generated by the sicm compiler; do not edit. */\n";
   s += "#define _GNU_SOURCE\n#include <math.h>\n\n";
+  if (uses_linear_solve(t.outputs)) s += c_linear_solve_support();
   s += "void " + c_name + "(const double *in, double *out, const double *p);\n\n";
   s += emit_kernel_function(t, c_name, false);
   return s;

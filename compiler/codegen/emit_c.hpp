@@ -36,6 +36,14 @@ std::string emit_c_assignments(const std::vector<ExprId> &values,
                                const std::function<std::string(Symbol *)> &spell,
                                const std::string &temp_prefix, const std::string &indent);
 
+// Does any output depend on a solve node (algebra/linear_solve.hpp)?
+bool uses_linear_solve(const std::vector<ExprId> &outputs);
+
+// The C functions that the code of solve nodes calls (static inline, so a
+// unit that includes them and calls none compiles without warnings), for
+// the top of a translation unit after <math.h>.
+std::string c_linear_solve_support();
+
 // s with every byte outside [A-Za-z0-9_] replaced by '_', cut to max_len
 // bytes; "anonymous" if s is empty.
 std::string c_sanitize(std::string_view s, size_t max_len = 48);

@@ -23,6 +23,7 @@
 #include <set>
 #include <unordered_set>
 
+#include "algebra/linear_solve.hpp"
 #include "codegen/emit_c.hpp"
 #include "syntax/error.hpp"
 
@@ -76,6 +77,9 @@ public:
                       ". Do not edit. */\n";
     out += "#define _GNU_SOURCE\n#include <math.h>\n#include <stddef.h>\n\n"
            "#include \"sicm/runtime.h\"\n\n";
+    // Every linear solve ends in a test that writes sicm_singular_nan().
+    if ((functions + main_body).find("sicm_singular_nan()") != std::string::npos)
+      out += c_linear_solve_support();
     for (int i = 1; i <= p_.plots; ++i)
       out += "static sicm_plot *plot" + std::to_string(i) + ";\n";
     for (size_t i = 0; i < p_.cells.size(); ++i)
@@ -138,10 +142,12 @@ private:
         break;
       }
       case ExprKind::Call:
-        throw Error(ErrorKind::Syntax, where ? where->loc : SrcLoc{},
-                    "cannot compile: a numerical result applies the unknown function " +
-                        expr_debug_string(n.head),
-                    "a literal function has no numeric value at run time");
+        if (!is_solve_node(id))
+          throw Error(ErrorKind::Syntax, where ? where->loc : SrcLoc{},
+                      "cannot compile: a numerical result applies the unknown function " +
+                          expr_debug_string(n.head),
+                      "a literal function has no numeric value at run time");
+        [[fallthrough]];
       case ExprKind::Apply: {
         const ExprId *args = expr_args(id);
         stack.insert(stack.end(), args, args + n.nargs);

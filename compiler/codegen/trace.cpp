@@ -14,12 +14,13 @@
 #include <cmath>
 #include <unordered_set>
 
+#include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "codegen/emit_c.hpp"
-#include "codegen/evaluation_form.hpp"
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
+#include "codegen/kernel_form.hpp"
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
@@ -49,17 +50,9 @@ std::string brief(Value v) {
   return s;
 }
 
-// The expression node of a simplified scalar leaf, or kNoExpr if the leaf is
-// not a number, a symbol or an expression.
-ExprId leaf_expr(Value leaf) {
-  if (is_number(leaf)) return expr_from_number(leaf);
-  if (leaf.is(Tag::Symbol)) return expr_symbol(leaf.symbol());
-  if (leaf.is(Tag::Expr)) return static_cast<ExprId>(leaf.i);
-  return kNoExpr;
-}
-
-// Check that every node under `root` is a number, an input symbol or an
-// Apply; `seen` is shared across the leaves so each node is visited once.
+// Check that every node under `root` is a number, an input symbol, an
+// Apply or a solve node; `seen` is shared across the leaves so each node is
+// visited once.
 bool check_expression(ExprId root, const std::unordered_set<Symbol *> &inputs,
                       std::unordered_set<ExprId> &seen, std::string *why_not) {
   std::vector<ExprId> stack{root};
@@ -79,9 +72,12 @@ bool check_expression(ExprId root, const std::unordered_set<Symbol *> &inputs,
       }
       break;
     case ExprKind::Call:
-      *why_not = "the result applies the unknown function " + expr_debug_string(n.head) +
-                 " (a literal function cannot be compiled)";
-      return false;
+      if (!is_solve_node(id)) {
+        *why_not = "the result applies the unknown function " + expr_debug_string(n.head) +
+                   " (a literal function cannot be compiled)";
+        return false;
+      }
+      [[fallthrough]];
     case ExprKind::Apply: {
       const ExprId *args = expr_args(id);
       stack.insert(stack.end(), args, args + n.nargs);
@@ -92,88 +88,35 @@ bool check_expression(ExprId root, const std::unordered_set<Symbol *> &inputs,
   return true;
 }
 
-// The number of distinct nodes under root, counting up to `cap` at most.
-size_t dag_size(ExprId root, size_t cap) {
-  std::vector<ExprId> stack{root};
-  std::unordered_set<ExprId> seen;
-  while (!stack.empty() && seen.size() < cap) {
-    ExprId id = stack.back();
-    stack.pop_back();
-    if (!seen.insert(id).second || expr_kind(id) != ExprKind::Apply) continue;
-    const ExprId *args = expr_args(id);
-    stack.insert(stack.end(), args, args + expr_node(id).nargs);
-  }
-  return seen.size();
-}
-
-// A result leaf as a checked kernel output (kernel_output_form chooses the
-// form), or kNoExpr: with *not_number set when the leaf is not a number at
-// all, else with the reason in *why_not. The traced form is used only if it checks: it may
-// still hold what simplification cancels (a symbol times zero).
-ExprId output_expr(Value leaf, const std::unordered_set<Symbol *> &inputs,
-                   std::unordered_set<ExprId> &seen, bool *not_number, std::string *why_not) {
-  ExprId simplified = leaf_expr(simplify_value(leaf)), traced = leaf_expr(leaf);
-  if (simplified != kNoExpr && traced != kNoExpr &&
-      kernel_output_form(traced, simplified) == traced) {
-    std::string traced_why;
-    std::unordered_set<ExprId> traced_seen; // a failed check leaves its nodes in it
-    if (check_expression(traced, inputs, traced_seen, &traced_why)) return traced;
-  }
-  *not_number = simplified == kNoExpr;
-  if (*not_number) return kNoExpr;
-  return check_expression(simplified, inputs, seen, why_not) ? simplified : kNoExpr;
-}
-
-} // namespace
-
-// The fuzz target emit-3 found the expansion: (expt (+ (* 2 x) (expt x 3)
-// (sinh y)) 216) took gcc -O2 minutes. Growth by a factor of 8 (and 256
-// nodes) leaves room for what simplification legitimately multiplies out
-// (products of small sums, a cube of a binomial).
-constexpr size_t kMaxSimplifiedGrowth = 8;
-constexpr size_t kSimplifiedSlack = 256;
-
-ExprId kernel_output_form(ExprId traced, ExprId simplified) {
-  size_t limit = kMaxSimplifiedGrowth * dag_size(traced, SIZE_MAX) + kSimplifiedSlack;
-  return dag_size(simplified, limit + 1) > limit ? traced : simplified;
-}
-
-namespace {
-
-// Turn the result's leaves into checked, simplified expressions.
+// Turn the result's leaves into checked kernel outputs (kernel_form.hpp
+// chooses their form).
 bool collect_outputs(Value result, Trace *t, std::string *why_not) {
+  gcvec<Value> leaves;
   if (is_structure(result)) {
-    gcvec<Value> leaves;
     structure_leaves(result, leaves);
     gcvec<Value> zeros(leaves.size(), Value::fixnum(0));
     t->result_shape = shape_from_leaves(result, false, zeros.data());
-    std::unordered_set<Symbol *> inputs(t->inputs.begin(), t->inputs.end());
-    std::unordered_set<ExprId> seen;
-    for (Value leaf : leaves) {
-      bool not_number;
-      ExprId id = output_expr(leaf, inputs, seen, &not_number, why_not);
-      if (id == kNoExpr) {
-        if (not_number)
-          *why_not = "the result has a component that is not a number: " + brief(leaf);
-        return false;
-      }
-      t->outputs.push_back(id);
-    }
-    to_evaluation_form(t->outputs);
-    return true;
+  } else {
+    leaves.push_back(result);
+    t->result_shape = Value::fixnum(0);
   }
-  std::unordered_set<Symbol *> inputs(t->inputs.begin(), t->inputs.end());
-  std::unordered_set<ExprId> seen;
-  bool not_number;
-  ExprId id = output_expr(result, inputs, seen, &not_number, why_not);
-  if (id == kNoExpr) {
-    if (not_number)
-      *why_not = "the result is not a number or a structure of numbers: " + brief(result);
+  for (Value leaf : leaves) {
+    if (leaf_expr(leaf) != kNoExpr) continue;
+    *why_not = is_structure(result)
+                   ? "the result has a component that is not a number: " + brief(leaf)
+                   : "the result is not a number or a structure of numbers: " + brief(result);
     return false;
   }
-  t->result_shape = Value::fixnum(0);
-  t->outputs.push_back(id);
-  to_evaluation_form(t->outputs);
+  std::unordered_set<Symbol *> inputs(t->inputs.begin(), t->inputs.end());
+  auto usable = [&](ExprId id) {
+    std::unordered_set<ExprId> seen;
+    std::string ignored;
+    return check_expression(id, inputs, seen, &ignored);
+  };
+  t->outputs = kernel_outputs(leaves, usable);
+  std::unordered_set<ExprId> seen;
+  for (ExprId id : t->outputs)
+    if (!check_expression(id, inputs, seen, why_not)) return false;
   return true;
 }
 
@@ -218,6 +161,7 @@ bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_n
   }
   try {
     DecimalConstants decimal; // 9.8 means 49/5 in the kernel's algebra
+    KernelTracing tracing;    // a matrix of run-time values is solved, not inverted
     Value result = apply_procedure(proc, args.data(), static_cast<int>(args.size()));
     return collect_outputs(result, t, why_not);
   } catch (const Error &e) {

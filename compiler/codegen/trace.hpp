@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "algebra/expr.hpp"
+#include "codegen/kernel_form.hpp"
 #include "eval/value.hpp"
 
 namespace sicm {
@@ -24,7 +25,7 @@ namespace sicm {
 // Lives on the stack (it holds a Value and a gcvec that the collector must see).
 struct Trace {
   gcvec<Symbol *> inputs;      // x_i stands for in[i]
-  std::vector<ExprId> outputs; // out[j]: simplified, only numbers, x_i and ops.def applications
+  std::vector<ExprId> outputs; // out[j]: numbers, x_i, ops.def applications, solve nodes
   Value result_shape;          // the result with exact zeros at its leaves (0 for a scalar)
 };
 
@@ -33,13 +34,6 @@ struct Trace {
 // a one-line reason in *why_not when the procedure cannot be traced. Errors
 // the procedure raises on symbolic arguments are caught and become the reason.
 bool trace_procedure(Value proc, Value sample_args, Trace *out, std::string *why_not);
-
-// Which form of an output a kernel computes: `simplified`, unless
-// simplifying multiplied the size of `traced` (the simplifier's canonical
-// form expands powers of sums: a 216th power of a trinomial is 23,653
-// terms, a megabyte of C, and cancellation eats the expanded sum's value);
-// then `traced`, the same function.
-ExprId kernel_output_form(ExprId traced, ExprId simplified);
 
 // True if v is a number or a nested up/down structure whose leaves are numbers.
 bool is_numeric_shape(Value v);

@@ -44,9 +44,10 @@
 #include <unordered_set>
 
 #include "algebra/generic.hpp"
+#include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
-#include "codegen/evaluation_form.hpp"
+#include "codegen/kernel_form.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
 #include "eval/limits.hpp"
@@ -930,6 +931,38 @@ bool derivative_leaves(Value d, Value shape, gcvec<Value> &out) {
   return true;
 }
 
+// Does the expression refer to nothing but numbers and run-time values,
+// through operations and linear solves?
+bool only_run_time_values(ExprId root) {
+  std::vector<ExprId> stack{root};
+  std::unordered_set<ExprId> seen;
+  while (!stack.empty()) {
+    ExprId id = stack.back();
+    stack.pop_back();
+    if (!seen.insert(id).second) continue;
+    const ExprNode &n = expr_node(id);
+    if (n.kind == ExprKind::Symbol && !g_var_of.count(n.sym)) return false;
+    if (n.kind == ExprKind::Call && !is_solve_node(id)) return false;
+    if (n.kind != ExprKind::Apply && n.kind != ExprKind::Call) continue;
+    const ExprId *args = expr_args(id);
+    stack.insert(stack.end(), args, args + n.nargs);
+  }
+  return true;
+}
+
+// A system derivative's leaves as the outputs of its kernel, in the form
+// sicm run's kernels take (codegen/kernel_form.hpp), so that both compute
+// the same numbers.
+std::vector<ExprId> system_outputs(const gcvec<Value> &leaves, const char *who) {
+  for (Value leaf : leaves)
+    if (leaf_expr(leaf) == kNoExpr) expr_of(leaf, who); // raises: not a number
+  std::vector<ExprId> outputs = kernel_outputs(leaves, only_run_time_values);
+  for (size_t i = 0; i < outputs.size(); ++i)
+    if (!expr_is_number(outputs[i]) && !only_run_time_values(outputs[i]))
+      cannot_compile(here(), std::string(who) + " needs a number here, not " + describe(leaves[i]));
+  return outputs;
+}
+
 // Trace a system derivative on a state shaped like `state`; fills the
 // statement's callee, time_first and rate_one. The derivative is simplified,
 // as the interpreter's compiled derivatives are (evolve in `sicm run`
@@ -938,6 +971,7 @@ void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
   if (!is_state_shape(state)) wrong_type(state, 1, who);
   FunctionScope scope(procedure_name(sysder));
   DecimalConstants decimal; // as sicm run traces its kernels
+  KernelTracing tracing;    // as sicm run traces its kernels
   Value x = input_like(state);
   Value d = apply_procedure(sysder, &x, 1);
   gcvec<Value> leaves;
@@ -945,10 +979,7 @@ void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
     cannot_compile(here(), std::string("the system derivative passed to ") + who + " returns " +
                                describe(d) + ", which is not shaped like the state " +
                                describe(state));
-  std::vector<ExprId> outputs;
-  for (Value leaf : leaves)
-    outputs.push_back(expr_of(simplify_value(leaf), who));
-  to_evaluation_form(outputs); // as sicm run's kernels are emitted
+  std::vector<ExprId> outputs = system_outputs(leaves, who);
   current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
   s.callee = scope.id();
   size_t len;
@@ -970,6 +1001,7 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
   try {
     FunctionScope scope("jacobian");
     DecimalConstants decimal;
+    KernelTracing tracing;
     Value x = input_like(state);
     Value dsys = apply_procedure(d->global, &sysder, 1);
     Value j = apply_procedure(dsys, &x, 1);
@@ -977,10 +1009,7 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
     state_leaves(j, leaves);
     size_t n = current().inputs.size();
     if (leaves.size() != n * n) return;
-    std::vector<ExprId> outputs;
-    for (Value leaf : leaves)
-      outputs.push_back(expr_of(simplify_value(leaf), "jacobian"));
-    to_evaluation_form(outputs);
+    std::vector<ExprId> outputs = system_outputs(leaves, "jacobian");
     current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
     s.jacobian = scope.id();
   } catch (const Error &) {

@@ -407,6 +407,16 @@ void begin_evaluation(SrcLoc where) {
   reset_call_loc(where);
 }
 
+ExpressionBudget::ExpressionBudget(uint64_t nodes) : saved_ceiling_(limits_detail::expr_ceiling) {
+  uint64_t now = expr_count();
+  uint64_t ceiling = nodes > kUnlimited - now ? kUnlimited : now + nodes;
+  limits_detail::expr_ceiling = std::min(saved_ceiling_, ceiling);
+}
+
+ExpressionBudget::~ExpressionBudget() {
+  limits_detail::expr_ceiling = saved_ceiling_;
+}
+
 void check_expression_growth(double terms, const char *what) {
   if (limits_detail::interrupt.load(std::memory_order_relaxed)) interrupted(somewhere());
   uint64_t ceiling = limits_detail::expr_ceiling;

@@ -99,6 +99,22 @@ void reset_call_loc(SrcLoc where);
 // The stack guard tripped (check_stack): the recursion depth error.
 [[noreturn]] void stack_exhausted(SrcLoc where);
 
+// While one lives, at most `nodes` more expression nodes may be made (and
+// never more than the limit in force allows); past that, the expression
+// size limit's error is raised as usual. For work that has a cheaper way
+// out when it grows (kernel_outputs tries the canonical form of a kernel
+// within one and keeps the traced form if it does not fit). Nests.
+class ExpressionBudget {
+public:
+  explicit ExpressionBudget(uint64_t nodes);
+  ~ExpressionBudget();
+  ExpressionBudget(const ExpressionBudget &) = delete;
+  ExpressionBudget &operator=(const ExpressionBudget &) = delete;
+
+private:
+  uint64_t saved_ceiling_;
+};
+
 // ---- the evaluator's hot path ------------------------------------------------
 // Inline: eval() pays one decrement per step.
 namespace limits_detail {

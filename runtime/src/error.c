@@ -1,6 +1,8 @@
 /* The runtime's one error hook and the descriptions of its status codes. */
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "sicm/runtime.h"
 
@@ -42,6 +44,13 @@ const char *sicm_strerror(int status) {
   case SICM_EBRACKET: return "root not bracketed";
   case SICM_ECONV: return "convergence failure";
   case SICM_EFAILED: return "failure in a numerical library";
+  case SICM_ESINGULAR: return "singular matrix in a linear solve";
   }
   return "unknown status";
+}
+
+int sicm_is_singular_nan(double x) {
+  uint64_t bits;
+  memcpy(&bits, &x, sizeof bits);
+  return bits == SICM_SINGULAR_NAN_BITS;
 }

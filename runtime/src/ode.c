@@ -32,7 +32,16 @@ int sicm_ode_call_rhs(sicm_ode *o, double t, const double *y, double *dydt) {
     o->user_status = s;
     return SICM_EUSER;
   }
-  return sicm_ode_finite(o->dim, dydt) ? SICM_SUCCESS : SICM_EBADFUNC;
+  if (sicm_ode_finite(o->dim, dydt)) return SICM_SUCCESS;
+  /* A singular matrix is a property of the state, not of the step: no
+   * shorter step would help, so it stops the integration like a user
+   * function's refusal (sicm_ode_fail_user names it). */
+  for (size_t i = 0; i < o->dim; i++)
+    if (sicm_is_singular_nan(dydt[i])) {
+      o->user_status = SICM_ESINGULAR;
+      return SICM_EUSER;
+    }
+  return SICM_EBADFUNC;
 }
 
 int sicm_ode_call_jacobian(sicm_ode *o, double t, const double *y, double *dfdy, double *dfdt,
@@ -151,6 +160,10 @@ int sicm_ode_fail(sicm_ode *o, int status, double t, const double *y, const char
 }
 
 int sicm_ode_fail_user(sicm_ode *o, double t, const double *y) {
+  if (o->user_status == SICM_ESINGULAR)
+    return sicm_ode_fail(o, SICM_ESINGULAR, t, y, "singular matrix in a linear solve",
+                         "the system derivative divides by a matrix (a mass matrix?) that is "
+                         "singular or not positive definite there");
   char detail[96];
   snprintf(detail, sizeof detail, "a user function returned %d", o->user_status);
   return sicm_ode_fail(o, SICM_EUSER, t, y, "stopped by the system", detail);

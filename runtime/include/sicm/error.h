@@ -12,17 +12,29 @@ extern "C" {
  * `status != SICM_SUCCESS` and still tell the causes apart. */
 enum {
   SICM_SUCCESS = 0,
-  SICM_EINVAL = 1,   /* an argument is invalid (bad interval, dimension, tolerance) */
-  SICM_ENOMEM = 2,   /* memory could not be allocated */
-  SICM_EBADFUNC = 3, /* a user function produced a non-finite value (NaN or infinity) */
-  SICM_EUSER = 4,    /* a user function returned non-zero to stop the computation */
-  SICM_ESTEP = 5,    /* the step size became too small to make progress */
-  SICM_EMAXITER = 6, /* the allowed number of steps or iterations was exhausted */
-  SICM_ETOL = 7,     /* the requested tolerance cannot be reached */
-  SICM_EBRACKET = 8, /* the interval does not bracket a root */
-  SICM_ECONV = 9,    /* an inner iteration (Newton, linear solve) failed to converge */
-  SICM_EFAILED = 10  /* any other failure of an underlying library */
+  SICM_EINVAL = 1,    /* an argument is invalid (bad interval, dimension, tolerance) */
+  SICM_ENOMEM = 2,    /* memory could not be allocated */
+  SICM_EBADFUNC = 3,  /* a user function produced a non-finite value (NaN or infinity) */
+  SICM_EUSER = 4,     /* a user function returned non-zero to stop the computation */
+  SICM_ESTEP = 5,     /* the step size became too small to make progress */
+  SICM_EMAXITER = 6,  /* the allowed number of steps or iterations was exhausted */
+  SICM_ETOL = 7,      /* the requested tolerance cannot be reached */
+  SICM_EBRACKET = 8,  /* the interval does not bracket a root */
+  SICM_ECONV = 9,     /* an inner iteration (Newton, linear solve) failed to converge */
+  SICM_EFAILED = 10,  /* any other failure of an underlying library */
+  SICM_ESINGULAR = 11 /* a linear solve in a user function met a singular matrix */
 };
+
+/* The NaN that a compiled kernel writes into every output when a linear
+ * solve in it met a singular matrix (or, for a symmetric one such as a mass
+ * matrix, one that is not positive definite): its bits. An integrator that
+ * receives it from the system derivative stops with SICM_ESINGULAR and says
+ * so with the time and the state, where any other NaN would make it retry
+ * with a shorter step. */
+#define SICM_SINGULAR_NAN_BITS 0x7ff800005349474eULL
+
+/* sicm_is_singular_nan says whether x is that NaN. */
+int sicm_is_singular_nan(double x);
 
 /* sicm_strerror returns a short constant English description of a status
  * code ("step size too small", ...), or "unknown status" for a code it does

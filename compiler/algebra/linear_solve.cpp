@@ -1,0 +1,170 @@
+// Linear solves as expression nodes (see linear_solve.hpp).
+#include "algebra/linear_solve.hpp"
+
+#include <vector>
+
+#include "algebra/generic.hpp"
+#include "algebra/structure.hpp"
+#include "algebra/symbolic.hpp"
+#include "eval/number.hpp"
+
+namespace sicm {
+
+namespace {
+
+thread_local int g_kernel_tracing = 0;
+
+// A component that can stand in an expression: a number, a symbol or an
+// expression (not a structure, a differential, a function).
+bool is_scalar(Value v) {
+  return is_number(v) || is_symbolic(v);
+}
+
+ExprId scalar_expr(Value v) {
+  if (is_number(v)) return expr_from_number(v);
+  if (v.is(Tag::Symbol)) return expr_symbol(v.symbol());
+  return static_cast<ExprId>(v.i);
+}
+
+// A symbolic value of an expression node (numbers never reach here: a
+// solve node is a Call).
+Value call_value(ExprId id) {
+  Value v;
+  v.tag = Tag::Expr;
+  v.i = id;
+  return v;
+}
+
+// Should the n x n matrix entry(i, j) be left to a run-time factorization?
+// Not when symbolic inversion is cheap: numbers only, diagonal, or small.
+// A small matrix goes to a solve node only when it is singular whatever
+// the inputs (its determinant simplifies to 0): symbolic inversion would
+// fail at compile time, where the factorization fails when the kernel
+// runs, with the time and the state (a Lagrangian whose velocities do not
+// all appear squared).
+template <typename Entry> bool wants_solve(size_t n, Entry entry) {
+  if (g_kernel_tracing == 0) return false;
+  bool all_numbers = true, diagonal = true;
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      Value e = entry(i, j);
+      if (!is_scalar(e)) return false;
+      all_numbers = all_numbers && is_number(e);
+      diagonal = diagonal && (i == j || is_exact_zero(e));
+    }
+  if (all_numbers || diagonal) return false;
+  if (n > kMaxSymbolicSolve) return true;
+  Value m = make_matrix(n, n);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j)
+      matrix_at(as_matrix(m), i, j) = entry(i, j);
+  Value det = determinant(m);
+  return is_number(det) ? num_is_zero(det) : g_zero_p(simplify_value(det));
+}
+
+// The solution of M x = b as a structure of solve nodes (orientation up or
+// down), M given by entry(i, j).
+template <typename Entry>
+Value solve_structure(size_t n, Entry entry, const Value *b, bool result_up) {
+  std::vector<ExprId> args;
+  args.reserve(1 + n * n + n);
+  args.push_back(expr_integer(0));
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j)
+      args.push_back(scalar_expr(entry(i, j)));
+  for (size_t i = 0; i < n; ++i)
+    args.push_back(scalar_expr(b[i]));
+  gcvec<Value> x(n);
+  for (size_t k = 0; k < n; ++k) {
+    args[0] = expr_integer(static_cast<int64_t>(k));
+    x[k] = call_value(expr_call(solve_head(), args.data(), args.size()));
+  }
+  return make_structure_from(result_up, x.data(), n);
+}
+
+bool all_scalars(const Structure *s) {
+  for (size_t i = 0; i < s->len; ++i)
+    if (!is_scalar(s->items[i])) return false;
+  return true;
+}
+
+} // namespace
+
+KernelTracing::KernelTracing() {
+  ++g_kernel_tracing;
+}
+
+KernelTracing::~KernelTracing() {
+  --g_kernel_tracing;
+}
+
+ExprId solve_head() {
+  // A global: the collector scans it, so the uninterned symbol lives.
+  static Value head = make_uninterned_symbol("solve");
+  return expr_symbol(head.symbol());
+}
+
+bool is_solve_node(ExprId id) {
+  return expr_kind(id) == ExprKind::Call && expr_node(id).head == solve_head();
+}
+
+size_t solve_dimension(ExprId id) {
+  // nargs = 1 + n^2 + n
+  size_t rest = expr_node(id).nargs - 1, n = 0;
+  while (n * n + n < rest)
+    ++n;
+  return n;
+}
+
+size_t solve_component(ExprId id) {
+  int64_t k = 0;
+  expr_get_int64(expr_arg(id, 0), &k);
+  return static_cast<size_t>(k);
+}
+
+ExprId solve_matrix_entry(ExprId id, size_t i, size_t j) {
+  return expr_arg(id, 1 + i * solve_dimension(id) + j);
+}
+
+ExprId solve_rhs_entry(ExprId id, size_t i) {
+  size_t n = solve_dimension(id);
+  return expr_arg(id, 1 + n * n + i);
+}
+
+// (/ a s) is a times the inverse of s (structure.cpp). With C the matrix
+// whose columns are s's components (C(i, j) = s[j][i]), the inverse is the
+// structure of C^-1 with the dual orientations, and the product contracts
+// to C^-1 a exactly when a's orientation is that of s's components; the
+// result then has the dual of s's outer orientation. Other combinations
+// do not contract and are left to the general path.
+std::optional<Value> traced_structure_solve(Value a, Value s) {
+  if (g_kernel_tracing == 0 || !is_structure(a) || !is_structure(s)) return std::nullopt;
+  Structure *st = as_structure(s), *av = as_structure(a);
+  size_t n = st->len;
+  if (n == 0 || av->len != n || !all_scalars(av)) return std::nullopt;
+  for (size_t j = 0; j < n; ++j) {
+    Value c = st->items[j];
+    if (!is_structure(c) || as_structure(c)->len != n ||
+        as_structure(c)->up != as_structure(st->items[0])->up)
+      return std::nullopt;
+  }
+  bool inner_up = as_structure(st->items[0])->up;
+  if (av->up != inner_up) return std::nullopt;
+  auto entry = [&](size_t i, size_t j) { return as_structure(st->items[j])->items[i]; };
+  if (!wants_solve(n, entry)) return std::nullopt;
+  return solve_structure(n, entry, av->items, !st->up);
+}
+
+// (/ a m) with a an up is m^-1 a, an up (matrix_div and matrix_times_up).
+std::optional<Value> traced_matrix_solve(Value a, Value m) {
+  if (g_kernel_tracing == 0 || !is_structure(a) || !is_matrix(m)) return std::nullopt;
+  Matrix *mm = as_matrix(m);
+  Structure *av = as_structure(a);
+  size_t n = mm->rows;
+  if (mm->cols != n || !av->up || av->len != n || !all_scalars(av)) return std::nullopt;
+  auto entry = [&](size_t i, size_t j) { return matrix_at(mm, i, j); };
+  if (!wants_solve(n, entry)) return std::nullopt;
+  return solve_structure(n, entry, av->items, true);
+}
+
+} // namespace sicm

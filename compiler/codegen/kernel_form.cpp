@@ -1,0 +1,99 @@
+// Which form of a traced procedure's outputs a kernel computes (see kernel_form.hpp).
+#include "codegen/kernel_form.hpp"
+
+#include <optional>
+#include <string>
+#include <unordered_set>
+
+#include "algebra/symbolic.hpp"
+#include "codegen/emit_c.hpp"
+#include "codegen/evaluation_form.hpp"
+#include "codegen/local_rewrite.hpp"
+#include "eval/limits.hpp"
+#include "eval/number.hpp"
+#include "syntax/error.hpp"
+
+namespace sicm {
+
+namespace {
+
+// The fuzz target emit-3 found the expansion: (expt (+ (* 2 x) (expt x 3)
+// (sinh y)) 216) took gcc -O2 minutes. Growth by a factor of 8 (and 256
+// nodes) leaves room for what simplification legitimately multiplies out
+// (products of small sums, a cube of a binomial).
+constexpr size_t kMaxSimplifiedGrowth = 8;
+constexpr size_t kSimplifiedSlack = 256;
+
+// The length of the C that computes the outputs: what the choice between
+// two forms is measured by.
+size_t emitted_size(const std::vector<ExprId> &outputs) {
+  std::vector<std::string> targets(outputs.size(), "o");
+  return emit_c_assignments(
+             outputs, targets, [](Symbol *) { return std::string("x"); }, "t", "")
+      .size();
+}
+
+} // namespace
+
+ExprId leaf_expr(Value leaf) {
+  if (is_number(leaf)) return expr_from_number(leaf);
+  if (leaf.is(Tag::Symbol)) return expr_symbol(leaf.symbol());
+  if (leaf.is(Tag::Expr)) return static_cast<ExprId>(leaf.i);
+  return kNoExpr;
+}
+
+size_t dag_size(const std::vector<ExprId> &roots, size_t cap) {
+  std::vector<ExprId> stack(roots.begin(), roots.end());
+  std::unordered_set<ExprId> seen;
+  while (!stack.empty() && seen.size() < cap) {
+    ExprId id = stack.back();
+    stack.pop_back();
+    if (!seen.insert(id).second) continue;
+    ExprKind kind = expr_kind(id);
+    if (kind != ExprKind::Apply && kind != ExprKind::Call) continue;
+    const ExprId *args = expr_args(id);
+    stack.insert(stack.end(), args, args + expr_node(id).nargs);
+  }
+  return seen.size();
+}
+
+ExprId kernel_output_form(ExprId traced, ExprId simplified) {
+  size_t limit = kMaxSimplifiedGrowth * dag_size({traced}) + kSimplifiedSlack;
+  return dag_size({simplified}, limit + 1) > limit ? traced : simplified;
+}
+
+std::vector<ExprId> kernel_outputs(const gcvec<Value> &leaves,
+                                   const std::function<bool(ExprId)> &usable) {
+  std::vector<ExprId> traced;
+  for (Value leaf : leaves)
+    traced.push_back(leaf_expr(leaf));
+  traced = rewrite_locally(traced);
+  bool all_usable = true;
+  for (ExprId id : traced)
+    all_usable = all_usable && usable(id);
+  if (all_usable && dag_size(traced, kMaxCanonicalizedNodes + 1) > kMaxCanonicalizedNodes)
+    return traced;
+
+  std::vector<ExprId> simplified;
+  try {
+    // Within a budget when there is a way out: the traced form.
+    std::optional<ExpressionBudget> budget;
+    if (all_usable) budget.emplace(kCanonicalizationBudget);
+    for (size_t i = 0; i < leaves.size(); ++i) {
+      ExprId s = leaf_expr(simplify_value(leaves[i]));
+      bool keep_traced = usable(traced[i]) && kernel_output_form(traced[i], s) == traced[i];
+      simplified.push_back(keep_traced ? traced[i] : s);
+    }
+    to_evaluation_form(simplified);
+  } catch (const Error &) {
+    if (!all_usable) throw;
+    return traced;
+  }
+  if (!all_usable) return simplified;
+  return kCanonicalAdvantage * static_cast<double>(emitted_size(simplified)) <=
+                 static_cast<double>(emitted_size(traced))
+             ? simplified
+             : traced;
+}
+
+} // namespace sicm
