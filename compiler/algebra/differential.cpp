@@ -10,6 +10,8 @@
 #include "algebra/differential.hpp"
 
 #include <algorithm>
+#include <utility>
+#include <vector>
 
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
@@ -33,6 +35,20 @@ struct Differential {
 };
 
 uint32_t g_next_tag = 1;
+
+// The gradient groups (fresh_gradient_tags), as [first, last] tag ranges in
+// increasing order (tags only grow). Kept for the life of the process: a
+// differential can outlive the derivative that made it (inside a
+// procedure's result), and a tag is never reused.
+std::vector<std::pair<uint32_t, uint32_t>> g_groups;
+
+// The index of the gradient group of a tag, or -1.
+long group_of(uint32_t tag) {
+  auto it = std::upper_bound(g_groups.begin(), g_groups.end(), std::make_pair(tag, UINT32_MAX));
+  if (it == g_groups.begin()) return -1;
+  --it;
+  return tag <= it->second ? it - g_groups.begin() : -1;
+}
 
 void write_differential(std::string &out, const void *obj, bool display);
 const OpaqueKind kDifferentialKind = {"differential", write_differential, nullptr};
@@ -105,14 +121,27 @@ Value diff_add(Value a, Value b, bool subtract) {
   return from_terms(std::move(terms));
 }
 
+// Do two tag sets hold tags of one gradient group (whose product is 0)?
+bool share_a_group(const DTerm &x, const DTerm &y) {
+  if (g_groups.empty()) return false;
+  for (uint32_t i = 0; i < x.ntags; ++i) {
+    long g = group_of(x.tags[i]);
+    if (g < 0) continue;
+    for (uint32_t j = 0; j < y.ntags; ++j)
+      if (group_of(y.tags[j]) == g) return true;
+  }
+  return false;
+}
+
 Value diff_mul(Value a, Value b) {
   gcvec<DTerm> out;
   for (const DTerm &x : terms_of(a)) {
     for (const DTerm &y : terms_of(b)) {
-      // e_t² = 0: terms sharing a tag vanish.
+      // e_t² = 0: terms sharing a tag vanish, and so do products of two
+      // tags of one gradient group.
       std::vector<uint32_t> tags;
       std::set_union(x.tags, x.tags + x.ntags, y.tags, y.tags + y.ntags, std::back_inserter(tags));
-      if (tags.size() != x.ntags + y.ntags) continue;
+      if (tags.size() != x.ntags + y.ntags || share_a_group(x, y)) continue;
       out.push_back(DTerm{copy_tags(tags.data(), uint32_t(tags.size())), uint32_t(tags.size()),
                           g_mul(x.coef, y.coef)});
     }
@@ -147,6 +176,56 @@ Value unary_derivative(UnaryOp op, Value x) {
   internal_failure(__FILE__, __LINE__, "no derivative rule for a linear operation");
 }
 
+// v = finite + sum over the tags g of gradient group `group` of
+// tangent_g e_g (no term of v carries two tags of one group).
+void split_group(Value v, long group, Value *finite, std::vector<std::pair<uint32_t, Value>> &parts,
+                 gcvec<Value> &keep) {
+  gcvec<DTerm> fin;
+  std::vector<std::pair<uint32_t, gcvec<DTerm>>> tan; // by tag, in order of first appearance
+  for (const DTerm &t : terms_of(v)) {
+    uint32_t tag = 0;
+    for (uint32_t k = 0; k < t.ntags; ++k)
+      if (group_of(t.tags[k]) == group) tag = t.tags[k];
+    if (tag == 0) {
+      fin.push_back(t);
+      continue;
+    }
+    std::vector<uint32_t> tags;
+    for (uint32_t k = 0; k < t.ntags; ++k)
+      if (t.tags[k] != tag) tags.push_back(t.tags[k]);
+    DTerm rest{copy_tags(tags.data(), uint32_t(tags.size())), uint32_t(tags.size()), t.coef};
+    auto it = std::find_if(tan.begin(), tan.end(), [&](auto &p) { return p.first == tag; });
+    if (it == tan.end()) {
+      tan.emplace_back(tag, gcvec<DTerm>{});
+      it = tan.end() - 1;
+    }
+    it->second.push_back(rest);
+  }
+  *finite = from_terms(std::move(fin));
+  for (auto &[tag, terms] : tan) {
+    keep.push_back(from_terms(std::move(terms)));
+    parts.emplace_back(tag, keep.back());
+  }
+}
+
+// f(x) for x whose largest tag is in a gradient group, from f(x0) and the
+// slope f'(x0) (slope_of(x0)): f(x0) + sum_g f'(x0) x_g e_g. One evaluation
+// of f and f' for the whole gradient, where splitting one tag at a time
+// would evaluate them 2^k times for k tags.
+template <typename F, typename Slope>
+Value apply_on_group(Value x, long group, F f, Slope slope_of) {
+  Value x0;
+  std::vector<std::pair<uint32_t, Value>> parts;
+  gcvec<Value> keep;
+  split_group(x, group, &x0, parts, keep);
+  Value fx0 = f(x0), slope = slope_of(x0);
+  gcvec<DTerm> terms = terms_of(fx0);
+  for (auto &[tag, xg] : parts)
+    for (const DTerm &t : terms_of(times_infinitesimal(g_mul(slope, xg), tag)))
+      terms.push_back(t);
+  return from_terms(std::move(terms));
+}
+
 Value diff_unary(UnaryOp op, Value x) {
   if (op == UnaryOp::Neg) {
     gcvec<DTerm> terms = terms_of(x);
@@ -156,6 +235,10 @@ Value diff_unary(UnaryOp op, Value x) {
   }
   if (op == UnaryOp::ZeroP) return Value::boolean(false); // it has an infinitesimal part
   uint32_t e = max_differential_tag(x);
+  if (long group = group_of(e); group >= 0)
+    return apply_on_group(
+        x, group, [&](Value x0) { return g_unary(op, x0); },
+        [&](Value x0) { return unary_derivative(op, x0); });
   Value x0, x1;
   split_differential(x, e, &x0, &x1);
   Value fx0 = g_unary(op, x0);
@@ -166,6 +249,10 @@ Value diff_expt(Value base, Value exponent) {
   if (!is_differential(exponent)) {
     if (is_exact_zero(exponent)) return Value::fixnum(1);
     uint32_t e = max_differential_tag(base);
+    if (long group = group_of(e); group >= 0)
+      return apply_on_group(
+          base, group, [&](Value b0) { return g_expt(b0, exponent); },
+          [&](Value b0) { return g_mul(exponent, g_expt(b0, g_sub(exponent, Value::fixnum(1)))); });
     Value b0, b1;
     split_differential(base, e, &b0, &b1);
     Value n_minus_1 = g_sub(exponent, Value::fixnum(1));
@@ -178,6 +265,32 @@ Value diff_expt(Value base, Value exponent) {
 
 Value diff_atan2(Value y, Value x) {
   uint32_t e = std::max(max_differential_tag(y), max_differential_tag(x));
+  if (long group = group_of(e); group >= 0) {
+    // d atan2(y, x) = (x0 dy - y0 dx) / (x0^2 + y0^2), for every tag g.
+    Value y0, x0;
+    std::vector<std::pair<uint32_t, Value>> ys, xs;
+    gcvec<Value> keep;
+    split_group(y, group, &y0, ys, keep);
+    split_group(x, group, &x0, xs, keep);
+    Value r2 = g_add(g_square(x0), g_square(y0));
+    gcvec<DTerm> terms = terms_of(g_binary(BinaryOp::Atan2, y0, x0));
+    std::vector<uint32_t> tags;
+    for (auto &p : ys)
+      tags.push_back(p.first);
+    for (auto &p : xs)
+      if (std::find(tags.begin(), tags.end(), p.first) == tags.end()) tags.push_back(p.first);
+    for (uint32_t g : tags) {
+      Value dy = Value::fixnum(0), dx = Value::fixnum(0);
+      for (auto &p : ys)
+        if (p.first == g) dy = p.second;
+      for (auto &p : xs)
+        if (p.first == g) dx = p.second;
+      Value slope = g_div(g_sub(g_mul(x0, dy), g_mul(y0, dx)), r2);
+      for (const DTerm &t : terms_of(times_infinitesimal(slope, g)))
+        terms.push_back(t);
+    }
+    return from_terms(std::move(terms));
+  }
   Value y0, y1, x0, x1;
   split_differential(y, e, &y0, &y1);
   split_differential(x, e, &x0, &x1);
@@ -243,8 +356,26 @@ uint32_t fresh_differential_tag() {
   return g_next_tag++;
 }
 
+uint32_t fresh_gradient_tags(uint32_t n) {
+  SICM_ASSERT(n > 0);
+  uint32_t first = g_next_tag;
+  g_next_tag += n;
+  g_groups.emplace_back(first, first + n - 1);
+  return first;
+}
+
 Value times_infinitesimal(Value tangent, uint32_t tag) {
   gcvec<DTerm> terms = terms_of(tangent);
+  // A term that carries a tag of tag's gradient group times e_tag is 0.
+  long group = group_of(tag);
+  if (group >= 0)
+    terms.erase(std::remove_if(terms.begin(), terms.end(),
+                               [&](const DTerm &t) {
+                                 for (uint32_t k = 0; k < t.ntags; ++k)
+                                   if (group_of(t.tags[k]) == group) return true;
+                                 return false;
+                               }),
+                terms.end());
   for (DTerm &t : terms) {
     SICM_ASSERT(!has_tag(t, tag));
     std::vector<uint32_t> tags(t.tags, t.tags + t.ntags);

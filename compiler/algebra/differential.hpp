@@ -26,6 +26,14 @@ namespace sicm {
 bool is_differential(Value v);
 // A fresh infinitesimal tag (never reused).
 uint32_t fresh_differential_tag();
+// n fresh tags first, first + 1, ..., first + n - 1 (returns first) that
+// form one gradient: the product of any two of them is 0, not only of a tag
+// with itself. Perturbing every component of a structure by a tag of one
+// group gives all the partial derivatives in one evaluation, with no cross
+// terms e_i e_j to carry; operations on a differential whose largest tag is
+// in a group split off the whole group at once (one f and one f' for the
+// gradient).
+uint32_t fresh_gradient_tags(uint32_t n);
 // x + e_tag.
 Value add_infinitesimal(Value x, uint32_t tag);
 // The coefficient of e_tag in v: terms of v carrying the tag, with the tag

@@ -16,6 +16,7 @@
 #include "algebra/operator.hpp"
 #include "algebra/series.hpp"
 #include "algebra/structure.hpp"
+#include "algebra/symbolic.hpp"
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
@@ -47,9 +48,55 @@ Value select_at(Value v, const gcvec<Value> &path, size_t k, const char *who) {
   return v;
 }
 
+// The number of scalar leaves of x (numbers, symbolic values,
+// differentials) if x is made of them alone, else 0.
+size_t scalar_leaves(Value x) {
+  if (is_structure(x)) {
+    size_t n = 0;
+    Structure *s = as_structure(x);
+    for (size_t i = 0; i < s->len; ++i) {
+      size_t k = scalar_leaves(s->items[i]);
+      if (k == 0 && !(is_structure(s->items[i]) && as_structure(s->items[i])->len == 0)) return 0;
+      n += k;
+    }
+    return n;
+  }
+  return is_number(x) || is_symbolic(x) || is_differential(x) ? 1 : 0;
+}
+
+// x with leaf k (depth first) plus e_(first + k).
+Value perturb_leaves(Value x, uint32_t first, uint32_t &k) {
+  if (!is_structure(x)) return add_infinitesimal(x, first + k++);
+  Structure *s = as_structure(x);
+  Value out = make_structure(s->up, s->len);
+  for (size_t i = 0; i < s->len; ++i)
+    as_structure(out)->items[i] = perturb_leaves(s->items[i], first, k);
+  return out;
+}
+
+// The dual of x's shape (every orientation flipped) whose leaf k is the
+// coefficient of e_(first + k) in r.
+Value gradient_of(Value r, Value x, uint32_t first, uint32_t &k) {
+  if (!is_structure(x)) return extract_tangent(r, first + k++);
+  Structure *s = as_structure(x);
+  Value out = make_structure(!s->up, s->len);
+  for (size_t i = 0; i < s->len; ++i)
+    as_structure(out)->items[i] = gradient_of(r, s->items[i], first, k);
+  return out;
+}
+
 // d f(args) / d (component `path` of argument `arg`), where that component
-// is the scalar or structure `x`: a structure gives its dual of partials.
+// is the scalar or structure `x`: a structure gives its dual of partials,
+// all from one evaluation of f when x is made of scalars (each perturbed by
+// its own tag of one gradient group: differential.hpp).
 Value derivative_at(Value f, gcvec<Value> args, size_t arg, gcvec<Value> path, Value x) {
+  if (size_t n = is_structure(x) ? scalar_leaves(x) : 0; n >= 2) {
+    uint32_t first = fresh_gradient_tags(static_cast<uint32_t>(n)), k = 0;
+    args[arg] = replace_at(args[arg], path, 0, perturb_leaves(x, first, k));
+    Value r = apply_procedure(f, args.data(), static_cast<int>(args.size()));
+    k = 0;
+    return gradient_of(r, x, first, k);
+  }
   if (is_structure(x)) {
     Structure *s = as_structure(x);
     Value out = make_structure(!s->up, s->len);

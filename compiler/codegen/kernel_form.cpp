@@ -33,6 +33,30 @@ size_t emitted_size(const std::vector<ExprId> &outputs) {
       .size();
 }
 
+// The number of distinct expressions the outputs divide by (a quotient's
+// divisor, the base of a negative power), counting up to `cap` at most.
+size_t denominators(const std::vector<ExprId> &roots, size_t cap) {
+  std::vector<ExprId> stack(roots.begin(), roots.end());
+  std::unordered_set<ExprId> seen, divisors;
+  while (!stack.empty() && divisors.size() < cap) {
+    ExprId id = stack.back();
+    stack.pop_back();
+    if (!seen.insert(id).second) continue;
+    ExprKind kind = expr_kind(id);
+    if (kind != ExprKind::Apply && kind != ExprKind::Call) continue;
+    const ExprId *args = expr_args(id);
+    uint32_t n = expr_node(id).nargs;
+    if (expr_is_apply(id, Op::Div))
+      for (uint32_t i = n == 1 ? 0 : 1; i < n; ++i)
+        if (!expr_is_number(args[i])) divisors.insert(args[i]);
+    if (expr_is_apply(id, Op::Expt) && !expr_is_number(args[0]) && expr_is_number(args[1]) &&
+        expr_number_sign(args[1]) < 0)
+      divisors.insert(args[0]);
+    stack.insert(stack.end(), args, args + n);
+  }
+  return divisors.size();
+}
+
 } // namespace
 
 ExprId leaf_expr(Value leaf) {
@@ -71,7 +95,9 @@ std::vector<ExprId> kernel_outputs(const gcvec<Value> &leaves,
   bool all_usable = true;
   for (ExprId id : traced)
     all_usable = all_usable && usable(id);
-  if (all_usable && dag_size(traced, kMaxCanonicalizedNodes + 1) > kMaxCanonicalizedNodes)
+  if (all_usable &&
+      (dag_size(traced, kMaxCanonicalizedNodes + 1) > kMaxCanonicalizedNodes ||
+       denominators(traced, kMaxCanonicalizedDenominators + 1) > kMaxCanonicalizedDenominators))
     return traced;
 
   std::vector<ExprId> simplified;

@@ -18,7 +18,8 @@
 //   - the traced DAG is rewritten locally (codegen/local_rewrite.hpp: like
 //     terms and factors merged, coefficients folded; never enlarged);
 //   - if its outputs together have at most kMaxCanonicalizedNodes distinct
-//     nodes, each output is also brought to the canonical form (then to the
+//     nodes and divide by at most kMaxCanonicalizedDenominators distinct
+//     expressions, each output is also brought to the canonical form (then to the
 //     evaluation form of codegen/evaluation_form.hpp) within
 //     kCanonicalizationBudget new nodes, and the kernel keeps it if its C
 //     is kCanonicalAdvantage times shorter than the traced form's. Small
@@ -41,8 +42,17 @@ namespace sicm {
 
 // Kernels whose traced outputs have more distinct nodes than this are
 // never canonicalized (see above). The book's state derivatives have a few
-// hundred; a 3-link chain's, about a thousand.
-constexpr size_t kMaxCanonicalizedNodes = 1500;
+// hundred nodes; a 12-link chain's, 2,200, and its canonical form (each
+// entry of its mass matrix and forces a short polynomial in sines and
+// cosines) is two thirds of the traced form's C, and as quick to make.
+constexpr size_t kMaxCanonicalizedNodes = 20000;
+
+// Nor are kernels that divide by more distinct expressions than this: their
+// canonical form puts them all over one common denominator (the N-body
+// problem's accelerations over the product of every pair's distance). A
+// symbolic 2 x 2 inverse divides by its determinant alone, which the traced
+// form holds in up to three spellings (multiples of one another).
+constexpr size_t kMaxCanonicalizedDenominators = 4;
 
 // The canonical form is kept only when the traced form's C is this many
 // times longer: it must pay for itself clearly, since its expanded sums
