@@ -78,6 +78,9 @@ private:
       first = 1;
     }
     m.factors.assign(args.begin() + static_cast<long>(first), args.end());
+    // c (f g ...), as product() writes a coefficient times several factors.
+    if (first == 1 && m.factors.size() == 1 && expr_is_apply(m.factors[0], Op::Mul))
+      m.factors = expr_arg_vector(m.factors[0]);
     return m;
   }
 
@@ -133,6 +136,13 @@ private:
     }
     if (factors.empty()) return expr_from_number(m.coefficient);
     if (factors.size() == 1) return factors[0];
+    // A coefficient times several factors is c (f g ...): the product of the
+    // factors is a node of its own, which -(f g) and (f g) share (the force
+    // of a pair, added to one body and subtracted from the other).
+    if (factors.size() > 2 && expr_is_number(factors[0])) {
+      std::vector<ExprId> rest(factors.begin() + 1, factors.end());
+      return representative(Op::Mul, {factors[0], representative(Op::Mul, rest)});
+    }
     return representative(Op::Mul, factors);
   }
 

@@ -131,6 +131,12 @@ bool is_numeric_shape(Value v) {
   return true;
 }
 
+Value apply_traced(Value proc, gcvec<Value> args) {
+  DecimalConstants decimal; // 9.8 means 49/5 in the kernel's algebra
+  KernelTracing tracing;    // a matrix of run-time values is solved, not inverted
+  return apply_procedure(proc, args.data(), static_cast<int>(args.size()));
+}
+
 bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_not) {
   if (!is_procedure(proc)) {
     *why_not = "the object " + brief(proc) + " is not a procedure";
@@ -160,10 +166,7 @@ bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_n
                        : symbols[first]);
   }
   try {
-    DecimalConstants decimal; // 9.8 means 49/5 in the kernel's algebra
-    KernelTracing tracing;    // a matrix of run-time values is solved, not inverted
-    Value result = apply_procedure(proc, args.data(), static_cast<int>(args.size()));
-    return collect_outputs(result, t, why_not);
+    return collect_outputs(apply_traced(proc, args), t, why_not);
   } catch (const Error &e) {
     *why_not = std::string("applying it to symbolic arguments failed: ") + e.what();
     return false;

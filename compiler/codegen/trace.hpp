@@ -29,6 +29,16 @@ struct Trace {
   Value result_shape;          // the result with exact zeros at its leaves (0 for a scalar)
 };
 
+// The one way a procedure is traced into a kernel, by `sicm run`
+// (trace_procedure) and by `sicm build` (the residual functions of system
+// derivatives): proc applied to args whose scalar leaves are the symbols
+// that stand for the kernel's inputs, with flonums entering the algebra as
+// the decimals they were written as (DecimalConstants) and divisions by
+// matrices of run-time values as solve nodes (KernelTracing). The caller
+// takes the result's leaves (codegen/state_shape.hpp) and gives them to
+// kernel_outputs (codegen/kernel_form.hpp). Errors propagate.
+Value apply_traced(Value proc, gcvec<Value> args);
+
 // Trace `proc` on arguments shaped like the elements of the list sample_args
 // (each a number or a nested up/down structure of numbers). Returns false and
 // a one-line reason in *why_not when the procedure cannot be traced. Errors

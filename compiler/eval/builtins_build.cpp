@@ -48,6 +48,8 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "codegen/kernel_form.hpp"
+#include "codegen/state_shape.hpp"
+#include "codegen/trace.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
 #include "eval/limits.hpp"
@@ -595,70 +597,9 @@ template <const char *Name> Value P_identity_on_dynamic(Value *a, int n) {
 constexpr char kExactToInexact[] = "exact->inexact";
 constexpr char kInexact[] = "inexact";
 
-bool container_items_of(Value v);
-
-// ---- states: numbers in nested up/down structures and vectors ----------------------------
-
-// The components of a container (structure or vector), or null.
-Value *container_items(Value v, size_t *len) {
-  if (is_structure(v)) {
-    *len = as_structure(v)->len;
-    return as_structure(v)->items;
-  }
-  if (v.is(Tag::Vector)) {
-    *len = v.vector()->len;
-    return v.vector()->items;
-  }
-  return nullptr;
-}
-
 bool container_items_of(Value v) {
   size_t len;
   return container_items(v, &len) != nullptr;
-}
-
-void state_leaves(Value v, gcvec<Value> &out) {
-  size_t len;
-  Value *items = container_items(v, &len);
-  if (!items) {
-    out.push_back(v);
-    return;
-  }
-  for (size_t i = 0; i < len; ++i)
-    state_leaves(items[i], out);
-}
-
-size_t state_dimension(Value v) {
-  gcvec<Value> leaves;
-  state_leaves(v, leaves);
-  return leaves.size();
-}
-
-// A container shaped like `shape` (a structure or a vector) whose parts are
-// part(item, leaves) of its items in order; a non-container takes the next leaf.
-using PartFn = Value (*)(Value shape, const Value *&leaves);
-Value state_like(Value shape, const Value *&leaves, PartFn part) {
-  size_t len;
-  Value *items = container_items(shape, &len);
-  if (!items) return *leaves++;
-  gcvec<Value> parts;
-  for (size_t i = 0; i < len; ++i)
-    parts.push_back(part(items[i], leaves));
-  if (is_structure(shape))
-    return make_structure_from(as_structure(shape)->up, parts.data(), parts.size());
-  Value v = make_vector(parts.size(), Value::fixnum(0));
-  for (size_t i = 0; i < parts.size(); ++i)
-    v.vector()->items[i] = parts[i];
-  return v;
-}
-
-Value state_part(Value shape, const Value *&leaves) {
-  return state_like(shape, leaves, state_part);
-}
-
-Value state_from_leaves(Value shape, const gcvec<Value> &leaves) {
-  const Value *p = leaves.data();
-  return state_part(shape, p);
 }
 
 // ---- tracing procedures into functions ------------------------------------------------
@@ -908,27 +849,8 @@ std::string method_of(Value *a, int n, int i, const char *who) {
   return c;
 }
 
-// The leaves of a derivative d of a state shaped like `shape`: an exact 0
-// stands for a zero structure of the shape it replaces, as in the
-// interpreter ((up 1 0 0) for the state (up t (up x y) (down px py))).
-bool derivative_leaves(Value d, Value shape, gcvec<Value> &out) {
-  size_t n, m;
-  Value *shape_items = container_items(shape, &n);
-  if (!shape_items) {
-    if (!is_number(d) && !is_dynamic_scalar(d)) return false;
-    out.push_back(d);
-    return true;
-  }
-  if (is_number(d) && is_exact_zero(d)) {
-    for (size_t i = state_dimension(shape); i > 0; --i)
-      out.push_back(d);
-    return true;
-  }
-  Value *d_items = container_items(d, &m);
-  if (!d_items || m != n) return false;
-  for (size_t i = 0; i < n; ++i)
-    if (!derivative_leaves(d_items[i], shape_items[i], out)) return false;
-  return true;
+bool is_scalar_leaf(Value v) {
+  return is_number(v) || is_dynamic_scalar(v);
 }
 
 // Does the expression refer to nothing but numbers and run-time values,
@@ -970,12 +892,10 @@ std::vector<ExprId> system_outputs(const gcvec<Value> &leaves, const char *who) 
 void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
   if (!is_state_shape(state)) wrong_type(state, 1, who);
   FunctionScope scope(procedure_name(sysder));
-  DecimalConstants decimal; // as sicm run traces its kernels
-  KernelTracing tracing;    // as sicm run traces its kernels
-  Value x = input_like(state);
-  Value d = apply_procedure(sysder, &x, 1);
+  gcvec<Value> x{input_like(state)};
+  Value d = apply_traced(sysder, x); // as sicm run traces its kernels
   gcvec<Value> leaves;
-  if (!derivative_leaves(d, state, leaves))
+  if (!derivative_leaves(d, state, leaves, is_scalar_leaf))
     cannot_compile(here(), std::string("the system derivative passed to ") + who + " returns " +
                                describe(d) + ", which is not shaped like the state " +
                                describe(state));
@@ -1000,11 +920,9 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
   size_t nfunctions = g_prog->functions.size(), nvars = g_prog->vars.size();
   try {
     FunctionScope scope("jacobian");
-    DecimalConstants decimal;
-    KernelTracing tracing;
-    Value x = input_like(state);
     Value dsys = apply_procedure(d->global, &sysder, 1);
-    Value j = apply_procedure(dsys, &x, 1);
+    gcvec<Value> x{input_like(state)};
+    Value j = apply_traced(dsys, x);
     gcvec<Value> leaves;
     state_leaves(j, leaves);
     size_t n = current().inputs.size();
