@@ -13,6 +13,7 @@ namespace sicm {
 namespace {
 
 thread_local int g_kernel_tracing = 0;
+bool (*g_is_run_time)(Value) = nullptr;
 
 // A component that can stand in an expression: a number, a symbol or an
 // expression (not a structure, a differential, a function).
@@ -62,10 +63,31 @@ template <typename Entry> bool wants_solve(size_t n, Entry entry) {
   return is_number(det) ? num_is_zero(det) : g_zero_p(simplify_value(det));
 }
 
-// The solution of M x = b as a structure of solve nodes (orientation up or
-// down), M given by entry(i, j).
+// Is the n x n matrix entry(i, j) made of numbers and run-time values, at
+// least one of them a run-time value, outside a kernel in sicm build?
+template <typename Entry> bool wants_interpreted_solve(size_t n, Entry entry) {
+  if (g_kernel_tracing != 0 || !g_is_run_time) return false;
+  bool run_time = false;
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      Value e = entry(i, j);
+      if (!is_number(e) && !g_is_run_time(e)) return false;
+      run_time = run_time || !is_number(e);
+    }
+  return run_time;
+}
+
+bool all_numbers_or_run_time(const Structure *s) {
+  for (size_t i = 0; i < s->len; ++i)
+    if (!is_number(s->items[i]) && !(g_is_run_time && g_is_run_time(s->items[i]))) return false;
+  return true;
+}
+
+// The solution of M x = b as a structure of solve nodes with the given head
+// (orientation up or down), M given by entry(i, j).
 template <typename Entry>
-Value solve_structure(size_t n, Entry entry, const Value *b, bool result_up) {
+Value solve_structure(size_t n, Entry entry, const Value *b, bool result_up,
+                      ExprId head = solve_head()) {
   std::vector<ExprId> args;
   args.reserve(1 + n * n + n);
   args.push_back(expr_integer(0));
@@ -77,7 +99,7 @@ Value solve_structure(size_t n, Entry entry, const Value *b, bool result_up) {
   gcvec<Value> x(n);
   for (size_t k = 0; k < n; ++k) {
     args[0] = expr_integer(static_cast<int64_t>(k));
-    x[k] = call_value(expr_call(solve_head(), args.data(), args.size()));
+    x[k] = call_value(expr_call(head, args.data(), args.size()));
   }
   return make_structure_from(result_up, x.data(), n);
 }
@@ -104,8 +126,23 @@ ExprId solve_head() {
   return expr_symbol(head.symbol());
 }
 
+ExprId interpreted_solve_head() {
+  static Value head = make_uninterned_symbol("solve-as-interpreted");
+  return expr_symbol(head.symbol());
+}
+
+void set_run_time_value_test(bool (*is_run_time)(Value)) {
+  g_is_run_time = is_run_time;
+}
+
 bool is_solve_node(ExprId id) {
-  return expr_kind(id) == ExprKind::Call && expr_node(id).head == solve_head();
+  if (expr_kind(id) != ExprKind::Call) return false;
+  ExprId head = expr_node(id).head;
+  return head == solve_head() || head == interpreted_solve_head();
+}
+
+bool is_interpreted_solve(ExprId id) {
+  return expr_kind(id) == ExprKind::Call && expr_node(id).head == interpreted_solve_head();
 }
 
 size_t solve_dimension(ExprId id) {
@@ -138,7 +175,8 @@ ExprId solve_rhs_entry(ExprId id, size_t i) {
 // result then has the dual of s's outer orientation. Other combinations
 // do not contract and are left to the general path.
 std::optional<Value> traced_structure_solve(Value a, Value s) {
-  if (g_kernel_tracing == 0 || !is_structure(a) || !is_structure(s)) return std::nullopt;
+  if ((g_kernel_tracing == 0 && !g_is_run_time) || !is_structure(a) || !is_structure(s))
+    return std::nullopt;
   Structure *st = as_structure(s), *av = as_structure(a);
   size_t n = st->len;
   if (n == 0 || av->len != n || !all_scalars(av)) return std::nullopt;
@@ -151,18 +189,23 @@ std::optional<Value> traced_structure_solve(Value a, Value s) {
   bool inner_up = as_structure(st->items[0])->up;
   if (av->up != inner_up) return std::nullopt;
   auto entry = [&](size_t i, size_t j) { return as_structure(st->items[j])->items[i]; };
+  if (wants_interpreted_solve(n, entry) && all_numbers_or_run_time(av))
+    return solve_structure(n, entry, av->items, !st->up, interpreted_solve_head());
   if (!wants_solve(n, entry)) return std::nullopt;
   return solve_structure(n, entry, av->items, !st->up);
 }
 
 // (/ a m) with a an up is m^-1 a, an up (matrix_div and matrix_times_up).
 std::optional<Value> traced_matrix_solve(Value a, Value m) {
-  if (g_kernel_tracing == 0 || !is_structure(a) || !is_matrix(m)) return std::nullopt;
+  if ((g_kernel_tracing == 0 && !g_is_run_time) || !is_structure(a) || !is_matrix(m))
+    return std::nullopt;
   Matrix *mm = as_matrix(m);
   Structure *av = as_structure(a);
   size_t n = mm->rows;
   if (mm->cols != n || !av->up || av->len != n || !all_scalars(av)) return std::nullopt;
   auto entry = [&](size_t i, size_t j) { return matrix_at(mm, i, j); };
+  if (wants_interpreted_solve(n, entry) && all_numbers_or_run_time(av))
+    return solve_structure(n, entry, av->items, true, interpreted_solve_head());
   if (!wants_solve(n, entry)) return std::nullopt;
   return solve_structure(n, entry, av->items, true);
 }

@@ -49,11 +49,24 @@ public:
   KernelTracing &operator=(const KernelTracing &) = delete;
 };
 
-// The head of every solve node.
+// The head of every solve node a kernel factors.
 ExprId solve_head();
 
-// Is id a solve node? Its dimension n, component k, and entries.
+// sicm build, outside kernels: a division by a matrix with run-time entries
+// in top-level code (a Hamiltonian made by Lagrangian->Hamiltonian,
+// evaluated on a final state) must compute what `sicm run`'s interpreter
+// computes, to the last bit. Its components are solve nodes with this head
+// instead, which the C emitter writes as a call of
+// sicm_linalg_solve_as_interpreted (sicm/linalg.h): Gauss-Jordan with the
+// interpreter's pivoting and order of operations. Build mode says which
+// values are run-time values; without it (sicm run) there are none.
+ExprId interpreted_solve_head();
+void set_run_time_value_test(bool (*is_run_time)(Value));
+
+// Is id a solve node (of either head)? Its dimension n, component k, and
+// entries.
 bool is_solve_node(ExprId id);
+bool is_interpreted_solve(ExprId id);
 size_t solve_dimension(ExprId id);
 size_t solve_component(ExprId id);
 ExprId solve_matrix_entry(ExprId id, size_t i, size_t j);

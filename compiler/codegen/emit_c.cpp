@@ -342,7 +342,8 @@ private:
   // uses that has a name already has one (smaller ids were handled first).
   void emit_named(ExprId id) {
     if (is_solve_node(id)) {
-      name_[id] = solution(id) + "[" + std::to_string(solve_component(id)) + "]";
+      std::string x = is_interpreted_solve(id) ? interpreted_solution(id) : solution(id);
+      name_[id] = x + "[" + std::to_string(solve_component(id)) + "]";
       return;
     }
     auto p = partner_.find(id);
@@ -426,6 +427,32 @@ private:
       body_ += "  sicm_ldlt_solve(" + dim + ", " + f.array + ", " + x + ");\n";
     else
       body_ += "  sicm_lu_solve(" + dim + ", " + f.array + ", " + f.pivots + ", " + x + ");\n";
+    solutions_.emplace(std::move(key), x);
+    return x;
+  }
+
+  // The array that holds the solution of an interpreted solve node's system
+  // (linear_solve.hpp), computed on first use by the runtime as the
+  // interpreter computes it.
+  std::string interpreted_solution(ExprId solve) {
+    size_t n = solve_dimension(solve);
+    std::vector<ExprId> key{solve_head()};
+    std::string matrix, rhs;
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j) {
+        key.push_back(solve_matrix_entry(solve, i, j));
+        matrix += (matrix.empty() ? "" : ", ") + ref(key.back()).text;
+      }
+    for (size_t i = 0; i < n; ++i) {
+      key.push_back(solve_rhs_entry(solve, i));
+      rhs += (i ? ", " : "") + ref(key.back()).text;
+    }
+    auto hit = solutions_.find(key);
+    if (hit != solutions_.end()) return hit->second;
+    std::string x = temp(), dim = std::to_string(n);
+    body_ += "  double " + x + "[" + dim + "];\n";
+    body_ += "  sicm_linalg_solve_as_interpreted(" + dim + ", (const double[]){" + matrix +
+             "}, (const double[]){" + rhs + "}, " + x + ");\n";
     solutions_.emplace(std::move(key), x);
     return x;
   }

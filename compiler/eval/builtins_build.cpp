@@ -2615,6 +2615,9 @@ Value prepare_toplevel(Value v) {
 } // namespace
 
 void begin_build_mode(ResidualProgram *program) {
+  // Divisions by matrices of run-time values outside kernels compute as
+  // the interpreter does (algebra/linear_solve.hpp).
+  set_run_time_value_test(is_dynamic_scalar);
   g_blocks = {nullptr};
   g_bottom = Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kBottomKind, nullptr}));
   g_prog = program;
