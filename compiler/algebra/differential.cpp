@@ -180,8 +180,10 @@ Value unary_derivative(UnaryOp op, Value x) {
 // tangent_g e_g (no term of v carries two tags of one group).
 void split_group(Value v, long group, Value *finite, std::vector<std::pair<uint32_t, Value>> &parts,
                  gcvec<Value> &keep) {
-  gcvec<DTerm> fin;
-  std::vector<std::pair<uint32_t, gcvec<DTerm>>> tan; // by tag, in order of first appearance
+  // The tangent terms in one collected vector (a std::vector of gcvecs
+  // would hide them from the collector), with the tag each belongs to.
+  gcvec<DTerm> fin, tan;
+  std::vector<uint32_t> tan_tag, order; // order: the tags, by first appearance
   for (const DTerm &t : terms_of(v)) {
     uint32_t tag = 0;
     for (uint32_t k = 0; k < t.ntags; ++k)
@@ -193,16 +195,16 @@ void split_group(Value v, long group, Value *finite, std::vector<std::pair<uint3
     std::vector<uint32_t> tags;
     for (uint32_t k = 0; k < t.ntags; ++k)
       if (t.tags[k] != tag) tags.push_back(t.tags[k]);
-    DTerm rest{copy_tags(tags.data(), uint32_t(tags.size())), uint32_t(tags.size()), t.coef};
-    auto it = std::find_if(tan.begin(), tan.end(), [&](auto &p) { return p.first == tag; });
-    if (it == tan.end()) {
-      tan.emplace_back(tag, gcvec<DTerm>{});
-      it = tan.end() - 1;
-    }
-    it->second.push_back(rest);
+    tan.push_back(
+        DTerm{copy_tags(tags.data(), uint32_t(tags.size())), uint32_t(tags.size()), t.coef});
+    tan_tag.push_back(tag);
+    if (std::find(order.begin(), order.end(), tag) == order.end()) order.push_back(tag);
   }
   *finite = from_terms(std::move(fin));
-  for (auto &[tag, terms] : tan) {
+  for (uint32_t tag : order) {
+    gcvec<DTerm> terms;
+    for (size_t i = 0; i < tan.size(); ++i)
+      if (tan_tag[i] == tag) terms.push_back(tan[i]);
     keep.push_back(from_terms(std::move(terms)));
     parts.emplace_back(tag, keep.back());
   }
@@ -467,6 +469,18 @@ Value extract_tangent(Value v, uint32_t tag) {
   Value finite, tangent;
   split_differential(v, tag, &finite, &tangent);
   return tangent;
+}
+
+void split_by_tag(Value v, uint32_t tag, Value *finite,
+                  std::vector<std::pair<uint32_t, Value>> &parts, gcvec<Value> &keep) {
+  if (long group = group_of(tag); group >= 0) {
+    split_group(v, group, finite, parts, keep);
+    return;
+  }
+  Value tangent;
+  split_differential(v, tag, finite, &tangent);
+  keep.push_back(tangent);
+  if (!is_exact_zero(tangent)) parts.emplace_back(tag, tangent);
 }
 
 void register_differential_arith() {

@@ -18,6 +18,8 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "eval/value.hpp"
 
@@ -47,6 +49,13 @@ uint32_t max_differential_tag(Value v);
 void split_differential(Value v, uint32_t tag, Value *finite, Value *tangent);
 // tangent·e_tag (the tangent must not carry the tag).
 Value times_infinitesimal(Value tangent, uint32_t tag);
+// v = finite + sum of tangent_g e_g over the (tag, tangent) pairs appended
+// to parts, for g = tag or, if tag is in a gradient group, every tag of that
+// group that v carries (tangents are kept alive in keep). For rules that
+// need a derivative as a whole (a linear solve: d(M^-1 b) = M^-1 (db - dM
+// M^-1 b)) rather than through generic arithmetic.
+void split_by_tag(Value v, uint32_t tag, Value *finite,
+                  std::vector<std::pair<uint32_t, Value>> &parts, gcvec<Value> &keep);
 
 // Register the differential arithmetic type with generic arithmetic.
 void register_differential_arith();

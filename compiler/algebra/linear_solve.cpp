@@ -1,8 +1,10 @@
 // Linear solves as expression nodes (see linear_solve.hpp).
 #include "algebra/linear_solve.hpp"
 
+#include <algorithm>
 #include <vector>
 
+#include "algebra/differential.hpp"
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
@@ -104,6 +106,99 @@ Value solve_structure(size_t n, Entry entry, const Value *b, bool result_up,
   return make_structure_from(result_up, x.data(), n);
 }
 
+// C x = b for the n x n matrix c (row-major values, C(i, j) = c[i n + j]):
+// solve nodes when there are no differentials and the kernel should factor
+// C, else the symbolic inverse as before. Through differentials, by the
+// rule d(C^-1 b) = C^-1 (db - dC x0), x0 = C0^-1 b0, split on the largest
+// tag (or its whole gradient group): every tangent solves with the same
+// finite matrix C0, which the emitter factors once.
+gcvec<Value> solve_values(size_t n, const gcvec<Value> &c, const gcvec<Value> &b) {
+  uint32_t e = 0;
+  for (Value v : c)
+    e = std::max(e, max_differential_tag(v));
+  for (Value v : b)
+    e = std::max(e, max_differential_tag(v));
+  if (e == 0) {
+    auto entry = [&](size_t i, size_t j) { return c[i * n + j]; };
+    Value x;
+    if (wants_solve(n, entry)) {
+      x = solve_structure(n, entry, b.data(), true);
+    } else {
+      Value m = make_matrix(n, n);
+      std::copy(c.begin(), c.end(), as_matrix(m)->items);
+      x = g_mul(matrix_inverse(m, "/"), make_structure_from(true, b.data(), n));
+    }
+    return gcvec<Value>(as_structure(x)->items, as_structure(x)->items + n);
+  }
+  // The finite parts, and per tag the tangents (zero where a value lacks it).
+  gcvec<Value> c0(n * n), b0(n), dc, db, keep;
+  std::vector<uint32_t> tags;
+  auto slot = [&](uint32_t tag) {
+    size_t t = std::find(tags.begin(), tags.end(), tag) - tags.begin();
+    if (t == tags.size()) {
+      tags.push_back(tag);
+      dc.resize(tags.size() * n * n, Value::fixnum(0));
+      db.resize(tags.size() * n, Value::fixnum(0));
+    }
+    return t;
+  };
+  std::vector<std::pair<uint32_t, Value>> parts;
+  for (size_t k = 0; k < n * n; ++k) {
+    parts.clear();
+    split_by_tag(c[k], e, &c0[k], parts, keep);
+    for (auto &[tag, tangent] : parts)
+      dc[slot(tag) * n * n + k] = tangent;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    parts.clear();
+    split_by_tag(b[i], e, &b0[i], parts, keep);
+    for (auto &[tag, tangent] : parts)
+      db[slot(tag) * n + i] = tangent;
+  }
+  gcvec<Value> x0 = solve_values(n, c0, b0), x = x0;
+  for (size_t t = 0; t < tags.size(); ++t) {
+    gcvec<Value> r(n);
+    for (size_t i = 0; i < n; ++i) {
+      Value ri = db[t * n + i];
+      for (size_t j = 0; j < n; ++j)
+        ri = g_sub(ri, g_mul(dc[t * n * n + i * n + j], x0[j]));
+      r[i] = ri;
+    }
+    gcvec<Value> xt = solve_values(n, c0, r);
+    for (size_t i = 0; i < n; ++i)
+      x[i] = g_add(x[i], times_infinitesimal(xt[i], tags[t]));
+  }
+  return x;
+}
+
+// Scalars and differentials of scalars: what solve_values takes.
+bool is_solvable(Value v) {
+  return is_scalar(v) || is_differential(v);
+}
+
+// (/ a C) through differentials in a kernel (see solve_values), when C is
+// larger than kMaxSymbolicSolve: the symbolic inverse of a matrix of
+// differentials grows as fast as that of expressions.
+template <typename Entry>
+std::optional<Value> differential_solve(size_t n, Entry entry, const Structure *a, bool result_up) {
+  if (g_kernel_tracing == 0 || n <= kMaxSymbolicSolve) return std::nullopt;
+  bool differentials = false;
+  gcvec<Value> c(n * n), b(a->items, a->items + n);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j) {
+      c[i * n + j] = entry(i, j);
+      if (!is_solvable(c[i * n + j])) return std::nullopt;
+      differentials = differentials || is_differential(c[i * n + j]);
+    }
+  for (Value v : b) {
+    if (!is_solvable(v)) return std::nullopt;
+    differentials = differentials || is_differential(v);
+  }
+  if (!differentials) return std::nullopt;
+  gcvec<Value> x = solve_values(n, c, b);
+  return make_structure_from(result_up, x.data(), n);
+}
+
 bool all_scalars(const Structure *s) {
   for (size_t i = 0; i < s->len; ++i)
     if (!is_scalar(s->items[i])) return false;
@@ -179,7 +274,7 @@ std::optional<Value> traced_structure_solve(Value a, Value s) {
     return std::nullopt;
   Structure *st = as_structure(s), *av = as_structure(a);
   size_t n = st->len;
-  if (n == 0 || av->len != n || !all_scalars(av)) return std::nullopt;
+  if (n == 0 || av->len != n) return std::nullopt;
   for (size_t j = 0; j < n; ++j) {
     Value c = st->items[j];
     if (!is_structure(c) || as_structure(c)->len != n ||
@@ -189,6 +284,8 @@ std::optional<Value> traced_structure_solve(Value a, Value s) {
   bool inner_up = as_structure(st->items[0])->up;
   if (av->up != inner_up) return std::nullopt;
   auto entry = [&](size_t i, size_t j) { return as_structure(st->items[j])->items[i]; };
+  if (std::optional<Value> x = differential_solve(n, entry, av, !st->up)) return x;
+  if (!all_scalars(av)) return std::nullopt;
   if (wants_interpreted_solve(n, entry) && all_numbers_or_run_time(av))
     return solve_structure(n, entry, av->items, !st->up, interpreted_solve_head());
   if (!wants_solve(n, entry)) return std::nullopt;
@@ -202,8 +299,10 @@ std::optional<Value> traced_matrix_solve(Value a, Value m) {
   Matrix *mm = as_matrix(m);
   Structure *av = as_structure(a);
   size_t n = mm->rows;
-  if (mm->cols != n || !av->up || av->len != n || !all_scalars(av)) return std::nullopt;
+  if (mm->cols != n || !av->up || av->len != n) return std::nullopt;
   auto entry = [&](size_t i, size_t j) { return matrix_at(mm, i, j); };
+  if (std::optional<Value> x = differential_solve(n, entry, av, true)) return x;
+  if (!all_scalars(av)) return std::nullopt;
   if (wants_interpreted_solve(n, entry) && all_numbers_or_run_time(av))
     return solve_structure(n, entry, av->items, true, interpreted_solve_head());
   if (!wants_solve(n, entry)) return std::nullopt;
