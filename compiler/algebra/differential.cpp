@@ -76,6 +76,14 @@ const uint32_t *copy_tags(const uint32_t *tags, uint32_t n) {
   return mem;
 }
 
+// t with `tag` taken out of its tag set.
+DTerm without_tag(const DTerm &t, uint32_t tag) {
+  std::vector<uint32_t> tags;
+  for (uint32_t k = 0; k < t.ntags; ++k)
+    if (t.tags[k] != tag) tags.push_back(t.tags[k]);
+  return DTerm{copy_tags(tags.data(), uint32_t(tags.size())), uint32_t(tags.size()), t.coef};
+}
+
 // The terms of any value: a differential's own, or one untagged term.
 gcvec<DTerm> terms_of(Value v) {
   if (is_differential(v)) {
@@ -192,11 +200,7 @@ void split_group(Value v, long group, Value *finite, std::vector<std::pair<uint3
       fin.push_back(t);
       continue;
     }
-    std::vector<uint32_t> tags;
-    for (uint32_t k = 0; k < t.ntags; ++k)
-      if (t.tags[k] != tag) tags.push_back(t.tags[k]);
-    tan.push_back(
-        DTerm{copy_tags(tags.data(), uint32_t(tags.size())), uint32_t(tags.size()), t.coef});
+    tan.push_back(without_tag(t, tag));
     tan_tag.push_back(tag);
     if (std::find(order.begin(), order.end(), tag) == order.end()) order.push_back(tag);
   }
@@ -438,11 +442,7 @@ void split_differential(Value v, uint32_t tag, Value *finite, Value *tangent) {
       fin.push_back(t);
       continue;
     }
-    std::vector<uint32_t> tags;
-    for (uint32_t k = 0; k < t.ntags; ++k)
-      if (t.tags[k] != tag) tags.push_back(t.tags[k]);
-    tan.push_back(
-        DTerm{copy_tags(tags.data(), uint32_t(tags.size())), uint32_t(tags.size()), t.coef});
+    tan.push_back(without_tag(t, tag));
   }
   *finite = from_terms(std::move(fin));
   *tangent = from_terms(std::move(tan));

@@ -79,6 +79,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "algebra/symbolic.hpp"
@@ -171,6 +172,26 @@ bool expr_is_constant(ExprId id);
 // invalidated when the arena grows, so code that builds nodes while walking
 // one takes a copy first.
 std::vector<ExprId> expr_arg_vector(ExprId id);
+
+// Call visit(id) once for every node reachable from the roots (the
+// arguments of an Apply or a Call are reachable from it; a Call's head is
+// not), in no particular order, until visit returns false. Returns false
+// if it stopped early.
+template <typename Visit> bool expr_visit(const std::vector<ExprId> &roots, Visit visit) {
+  std::vector<ExprId> stack(roots.begin(), roots.end());
+  std::unordered_set<ExprId> seen;
+  while (!stack.empty()) {
+    ExprId id = stack.back();
+    stack.pop_back();
+    if (!seen.insert(id).second) continue;
+    if (!visit(id)) return false;
+    ExprKind kind = expr_kind(id);
+    if (kind != ExprKind::Apply && kind != ExprKind::Call) continue;
+    const ExprId *args = expr_args(id);
+    stack.insert(stack.end(), args, args + expr_node(id).nargs);
+  }
+  return true;
+}
 
 // ---- order ----
 // A total order on expressions, used for variables (C3) and for kernel

@@ -751,17 +751,7 @@ std::string emit_c_assignments(const std::vector<ExprId> &values,
 }
 
 bool uses_linear_solve(const std::vector<ExprId> &outputs) {
-  std::unordered_set<ExprId> seen;
-  std::vector<ExprId> stack(outputs.begin(), outputs.end());
-  while (!stack.empty()) {
-    ExprId id = stack.back();
-    stack.pop_back();
-    if (!seen.insert(id).second || !has_operands(id)) continue;
-    if (is_solve_node(id)) return true;
-    std::vector<ExprId> args = operands(id);
-    stack.insert(stack.end(), args.begin(), args.end());
-  }
-  return false;
+  return !expr_visit(outputs, [](ExprId id) { return !is_solve_node(id); });
 }
 
 // The factorizations are loops over n rather than unrolled code: their

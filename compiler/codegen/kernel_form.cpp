@@ -36,24 +36,18 @@ size_t emitted_size(const std::vector<ExprId> &outputs) {
 // The number of distinct expressions the outputs divide by (a quotient's
 // divisor, the base of a negative power), counting up to `cap` at most.
 size_t denominators(const std::vector<ExprId> &roots, size_t cap) {
-  std::vector<ExprId> stack(roots.begin(), roots.end());
-  std::unordered_set<ExprId> seen, divisors;
-  while (!stack.empty() && divisors.size() < cap) {
-    ExprId id = stack.back();
-    stack.pop_back();
-    if (!seen.insert(id).second) continue;
-    ExprKind kind = expr_kind(id);
-    if (kind != ExprKind::Apply && kind != ExprKind::Call) continue;
-    const ExprId *args = expr_args(id);
-    uint32_t n = expr_node(id).nargs;
-    if (expr_is_apply(id, Op::Div))
-      for (uint32_t i = n == 1 ? 0 : 1; i < n; ++i)
+  std::unordered_set<ExprId> divisors;
+  expr_visit(roots, [&](ExprId id) {
+    if (expr_is_apply(id, Op::Div)) {
+      std::vector<ExprId> args = expr_arg_vector(id);
+      for (size_t i = args.size() == 1 ? 0 : 1; i < args.size(); ++i)
         if (!expr_is_number(args[i])) divisors.insert(args[i]);
-    if (expr_is_apply(id, Op::Expt) && !expr_is_number(args[0]) && expr_is_number(args[1]) &&
-        expr_number_sign(args[1]) < 0)
-      divisors.insert(args[0]);
-    stack.insert(stack.end(), args, args + n);
-  }
+    }
+    if (expr_is_apply(id, Op::Expt) && !expr_is_number(expr_arg(id, 0)) &&
+        expr_is_number(expr_arg(id, 1)) && expr_number_sign(expr_arg(id, 1)) < 0)
+      divisors.insert(expr_arg(id, 0));
+    return divisors.size() < cap;
+  });
   return divisors.size();
 }
 
@@ -67,18 +61,9 @@ ExprId leaf_expr(Value leaf) {
 }
 
 size_t dag_size(const std::vector<ExprId> &roots, size_t cap) {
-  std::vector<ExprId> stack(roots.begin(), roots.end());
-  std::unordered_set<ExprId> seen;
-  while (!stack.empty() && seen.size() < cap) {
-    ExprId id = stack.back();
-    stack.pop_back();
-    if (!seen.insert(id).second) continue;
-    ExprKind kind = expr_kind(id);
-    if (kind != ExprKind::Apply && kind != ExprKind::Call) continue;
-    const ExprId *args = expr_args(id);
-    stack.insert(stack.end(), args, args + expr_node(id).nargs);
-  }
-  return seen.size();
+  size_t n = 0;
+  expr_visit(roots, [&](ExprId) { return ++n < cap; });
+  return n;
 }
 
 ExprId kernel_output_form(ExprId traced, ExprId simplified) {

@@ -856,20 +856,11 @@ bool is_scalar_leaf(Value v) {
 // Does the expression refer to nothing but numbers and run-time values,
 // through operations and linear solves?
 bool only_run_time_values(ExprId root) {
-  std::vector<ExprId> stack{root};
-  std::unordered_set<ExprId> seen;
-  while (!stack.empty()) {
-    ExprId id = stack.back();
-    stack.pop_back();
-    if (!seen.insert(id).second) continue;
+  return expr_visit({root}, [](ExprId id) {
     const ExprNode &n = expr_node(id);
-    if (n.kind == ExprKind::Symbol && !g_var_of.count(n.sym)) return false;
-    if (n.kind == ExprKind::Call && !is_solve_node(id)) return false;
-    if (n.kind != ExprKind::Apply && n.kind != ExprKind::Call) continue;
-    const ExprId *args = expr_args(id);
-    stack.insert(stack.end(), args, args + n.nargs);
-  }
-  return true;
+    if (n.kind == ExprKind::Symbol) return g_var_of.count(n.sym) > 0;
+    return n.kind != ExprKind::Call || is_solve_node(id);
+  });
 }
 
 // A system derivative's leaves as the outputs of its kernel, in the form
