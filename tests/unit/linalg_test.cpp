@@ -1,8 +1,10 @@
-// Unit tests of the runtime's eigenvalues (sicm/linalg.h, over Eigen) against
-// eigenvalues known in closed form.
+// Unit tests of the runtime's linear algebra (sicm/linalg.h): eigenvalues
+// (over Eigen) against eigenvalues known in closed form, and the solve built
+// programs use outside kernels against solutions known exactly.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "capture_errors.hpp"
@@ -96,6 +98,43 @@ TEST(LinalgEigenvalues, RejectsBadInput) {
   EXPECT_EQ(sicm_linalg_eigenvalues(2, bad, re, im), SICM_EINVAL);
   ASSERT_EQ(CaptureErrors::messages().size(), 2u);
   EXPECT_NE(CaptureErrors::messages()[1].find("(0, 1)"), std::string::npos);
+}
+
+// sicm_linalg_solve_as_interpreted: a system with an exact solution (the
+// pivots 4, then 2.5 after a row exchange, are exact in binary), one that
+// needs a row exchange for a zero pivot, and a singular one.
+TEST(LinalgSolveAsInterpreted, SolvesExactly) {
+  // A x = b with x = (1, -2, 3).
+  std::vector<double> a = {4, 2, 0, 2, 4, 1, 0, 1, 2}, b = {0, -3, 4}, x(3);
+  ASSERT_EQ(sicm_linalg_solve_as_interpreted(3, a.data(), b.data(), x.data()), SICM_SUCCESS);
+  EXPECT_NEAR(x[0], 1, 1e-15);
+  EXPECT_NEAR(x[1], -2, 1e-15);
+  EXPECT_NEAR(x[2], 3, 1e-15);
+}
+
+TEST(LinalgSolveAsInterpreted, ExchangesRowsForAZeroPivot) {
+  std::vector<double> a = {0, 1, 1, 0}, b = {5, 7}, x(2);
+  ASSERT_EQ(sicm_linalg_solve_as_interpreted(2, a.data(), b.data(), x.data()), SICM_SUCCESS);
+  EXPECT_EQ(x[0], 7);
+  EXPECT_EQ(x[1], 5);
+}
+
+TEST(LinalgSolveAsInterpreted, SingularGivesNaN) {
+  std::vector<double> a = {1, 2, 2, 4}, b = {1, 1}, x(2);
+  EXPECT_EQ(sicm_linalg_solve_as_interpreted(2, a.data(), b.data(), x.data()), SICM_ESINGULAR);
+  EXPECT_TRUE(std::isnan(x[0]) && std::isnan(x[1]));
+}
+
+// The NaN a kernel writes for a singular matrix is told apart from others.
+TEST(SingularNaN, RecognizedByItsBits) {
+  double d;
+  unsigned long long bits = SICM_SINGULAR_NAN_BITS;
+  static_assert(sizeof d == sizeof bits);
+  std::memcpy(&d, &bits, sizeof d);
+  EXPECT_TRUE(std::isnan(d));
+  EXPECT_TRUE(sicm_is_singular_nan(d));
+  EXPECT_FALSE(sicm_is_singular_nan(NAN));
+  EXPECT_FALSE(sicm_is_singular_nan(1.0));
 }
 
 } // namespace
