@@ -21,6 +21,7 @@
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
 #include "codegen/kernel_form.hpp"
+#include "codegen/state_shape.hpp"
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
@@ -148,22 +149,21 @@ bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_n
   }
   gcvec<Value> samples = list_to_vector(sample_args);
   gcvec<Value> args;
-  gcvec<Value> symbols;
   for (size_t i = 0; i < samples.size(); ++i) {
     if (!is_numeric_shape(samples[i])) {
       *why_not = std::string("the ") + ordinal(i) + " sample argument, " + brief(samples[i]) +
                  ", is not a number or a structure of numbers";
       return false;
     }
-    size_t first = symbols.size(), n = structure_dimension(samples[i]);
-    for (size_t k = 0; k < n; ++k) {
-      Value x = make_uninterned_symbol("x" + std::to_string(symbols.size()));
-      symbols.push_back(x);
-      t->inputs.push_back(x.symbol());
+    // The sample with fresh symbols x0, x1, ... for its leaves, as sicm
+    // build gives a traced procedure residual variables (input_like).
+    gcvec<Value> leaves;
+    state_leaves(samples[i], leaves);
+    for (Value &leaf : leaves) {
+      leaf = make_uninterned_symbol("x" + std::to_string(t->inputs.size()));
+      t->inputs.push_back(leaf.symbol());
     }
-    args.push_back(is_structure(samples[i])
-                       ? shape_from_leaves(samples[i], false, symbols.data() + first)
-                       : symbols[first]);
+    args.push_back(state_from_leaves(samples[i], leaves));
   }
   try {
     return collect_outputs(apply_traced(proc, args), t, why_not);
