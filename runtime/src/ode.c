@@ -13,6 +13,10 @@
 
 enum { kDefaultMaxSteps = 500000, kMaxStateShown = 16 };
 
+/* An interval of at most this many machine epsilons relative to t is taken
+ * in one Runge-Kutta step (sicm_ode_evolve). */
+enum { kTinyInterval = 1024 };
+
 /* ---- helpers shared by the backends ----------------------------------- */
 
 int sicm_ode_finite(size_t n, const double *v) {
@@ -393,6 +397,33 @@ void sicm_ode_reset(sicm_ode *o) {
   gsl_set_error_handler(old);
 }
 
+/* One classical Runge-Kutta step from t over h, in place: for an interval
+ * below the resolution of t (see sicm_ode_evolve) its error, O(h^5), is far
+ * below the rounding of y. */
+static int tiny_step(sicm_ode *o, double t, double h, double *y) {
+  const size_t n = o->dim;
+  double *k = malloc(5 * n * sizeof *k);
+  if (!k) return sicm_ode_fail(o, SICM_ENOMEM, t, y, "out of memory", NULL);
+  double *k1 = k, *k2 = k + n, *k3 = k + 2 * n, *k4 = k + 3 * n, *yt = k + 4 * n;
+  const double c[3] = {0.5, 0.5, 1.0};
+  double *stage[4] = {k1, k2, k3, k4};
+  int s = sicm_ode_call_rhs(o, t, y, k1);
+  for (int i = 1; i < 4 && s == SICM_SUCCESS; i++) {
+    for (size_t j = 0; j < n; j++)
+      yt[j] = y[j] + c[i - 1] * h * stage[i - 1][j];
+    s = sicm_ode_call_rhs(o, t + c[i - 1] * h, yt, stage[i]);
+  }
+  if (s == SICM_SUCCESS)
+    for (size_t j = 0; j < n; j++)
+      y[j] += h / 6 * (k1[j] + 2 * k2[j] + 2 * k3[j] + k4[j]);
+  free(k);
+  if (s == SICM_EUSER) return sicm_ode_fail_user(o, t, y);
+  if (s != SICM_SUCCESS)
+    return sicm_ode_fail(o, SICM_EBADFUNC, t, y, "non-finite derivative",
+                         "in the one step of an interval below the resolution of t");
+  return SICM_SUCCESS;
+}
+
 int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y) {
   if (!isfinite(*t) || !isfinite(t1)) {
     char detail[120];
@@ -409,8 +440,13 @@ int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y) {
   if ((o->have_last && (*t != o->t_last || memcmp(y, o->y_last, o->dim * sizeof *y) != 0)) ||
       o->h * (t1 - *t) < 0)
     sicm_ode_reset(o);
+  /* An interval this short is below what the adaptive methods can resolve
+   * in t (their shortest step is a few ulps of t): take it in one step, as
+   * scmutils does, instead of failing with "step size too small" (a
+   * Poincare-section refinement halves its step until it gets here). */
+  int tiny = fabs(t1 - *t) <= kTinyInterval * DBL_EPSILON * fmax(fabs(*t), fabs(t1));
   gsl_error_handler_t *old = gsl_set_error_handler_off();
-  int s = o->type->evolve(o, t, t1, y);
+  int s = tiny ? tiny_step(o, *t, t1 - *t, y) : o->type->evolve(o, t, t1, y);
   gsl_set_error_handler(old);
   if (s != SICM_SUCCESS) {
     sicm_ode_reset(o);
