@@ -7,17 +7,19 @@
 // writes them as products, by repeated squaring from 4 on, and negative ones
 // as 1.0 / ...) and powers with rational or computed exponents (pow). Up to
 // four of the values left on the stack are the kernel's outputs; a flag
-// byte says whether they are simplified first, as trace_procedure does
-// (kernel_output_form: what the emitter meets in practice; an expansion
-// that could pass kMaxExpressionNodes is then a sicm error, and the input
-// is not used; a kernel of degree past kMaxSimplifiedDegree is not
-// simplified, for time), or emitted as built (its other
-// shapes: Div chains, nested negations, constants folded by nobody).
+// byte says whether they are rewritten locally first (rewrite_locally, as
+// kernels that keep their traced DAG are), simplified first
+// (kernel_output_form, as small kernels may be: an expansion that could
+// pass kMaxExpressionNodes is then a sicm error, and the input is not
+// used; a kernel of degree past kMaxSimplifiedDegree is not simplified,
+// for time), or emitted as built (its other shapes: Div chains, nested
+// negations, constants folded by nobody).
 // Properties:
 //   1. emit_kernel_unit's C compiles with `cc -std=c11 -O2 -Wall -Wextra
 //      -Werror -fPIC -shared` (the JIT's flags and every warning an error);
 //   2. at 3 points (each input uniform in [-3, 3]), every output of the
 //      loaded kernel agrees with the interpreter's value of the same DAG
+//      (for a rewritten kernel, of the DAG as built, before the rewrites)
 //      (generic arithmetic on flonums, symbolic_apply node by node) to
 //      |k - i| <= 1e-12 max(|k|, |i|), or, at an ill-conditioned point,
 //      to 8 times the rounding-error bound of the DAG there (fuzz::NumEval),
@@ -79,6 +81,7 @@
 #include "algebra/symbolic.hpp"
 #include "codegen/emit_c.hpp"
 #include "codegen/kernel.hpp"
+#include "codegen/local_rewrite.hpp"
 #include "codegen/trace.hpp"
 #include "common.hpp"
 #include "eval/number.hpp"
@@ -618,7 +621,12 @@ void fuzz_setup() {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (size == 0) return 0;
   fuzz::Bytes in(data, size);
-  bool simplified = in.below(2) == 1;
+  // 0: emitted as built; 1: simplified first; 2: rewritten locally first
+  // (codegen/local_rewrite.hpp, as kernels that keep their traced DAG are),
+  // and then compared with the interpreter's value of the DAG as built: the
+  // rewrites must keep the function.
+  unsigned form = in.below(3);
+  bool simplified = form == 1, rewritten = form == 2;
   // The expression budget starts here, not after decoding: the nodes decode
   // builds would otherwise count against what the last input left, and a
   // limit error there is outside every handler.
@@ -657,6 +665,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   Pending k;
   k.bytes.assign(data, data + size);
   k.outputs.assign(t.outputs.begin(), t.outputs.end());
+  if (rewritten) t.outputs = rewrite_locally(t.outputs);
   k.src = emit_kernel_unit(t, kName, "fuzz");
   // A guard on the target's budget: units over kMaxUnitBytes are not
   // compiled, but counted at exit. Since emit-3 was fixed (an expanded
