@@ -45,6 +45,12 @@ int sicm_ode_call_rhs(sicm_ode *o, double t, const double *y, double *dydt) {
       o->user_status = SICM_ESINGULAR;
       return SICM_EUSER;
     }
+  for (size_t i = 0; i < o->dim; i++)
+    if (!isfinite(dydt[i])) {
+      o->bad_component = (long)i;
+      o->bad_value = dydt[i];
+      break;
+    }
   return SICM_EBADFUNC;
 }
 
@@ -159,6 +165,15 @@ int sicm_ode_fail(sicm_ode *o, int status, double t, const double *y, const char
   if (detail) {
     size_t len = strlen(o->message);
     snprintf(o->message + len, sizeof o->message - len, ": %s", detail);
+  }
+  if (status == SICM_EBADFUNC && o->bad_component >= 0 &&
+      strcmp(what, "non-finite derivative") == 0) {
+    char vbuf[SICM_DOUBLE_BUFSIZE];
+    sicm_format_double(vbuf, o->bad_value);
+    size_t len = strlen(o->message);
+    snprintf(o->message + len, sizeof o->message - len,
+             " (component %ld of the derivative, counting the time's as 0, was %s)",
+             o->bad_component, vbuf);
   }
   return sicm_error(status, "%s", o->message);
 }
@@ -348,6 +363,7 @@ sicm_ode *sicm_ode_alloc(const sicm_ode_step_type *T, size_t dim, sicm_ode_rhs f
   sicm_ode *o = calloc(1, sizeof *o);
   if (o) {
     *o = (sicm_ode){.type = T,
+                    .bad_component = -1,
                     .dim = dim,
                     .f = f,
                     .params = params,
@@ -435,6 +451,7 @@ int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y) {
     return sicm_ode_fail(o, SICM_EINVAL, *t, y, "non-finite state",
                          "the initial state has NaN or infinite components");
   if (*t == t1) return SICM_SUCCESS;
+  o->bad_component = -1;
   /* Restart the method if the caller moved the state or reversed direction:
    * multistep history and the step size belong to the old trajectory. */
   if ((o->have_last && (*t != o->t_last || memcmp(y, o->y_last, o->dim * sizeof *y) != 0)) ||

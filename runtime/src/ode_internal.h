@@ -49,6 +49,11 @@ struct sicm_ode {
   double *y_last;
 
   int user_status; /* what the rhs or Jacobian returned when it stopped us */
+  /* The first component of the derivative that was NaN or infinite in the
+   * last such evaluation (-1: none since evolve began), and its value, for
+   * the message of a "non-finite derivative" failure. */
+  long bad_component;
+  double bad_value;
   sicm_ode_stats stats;
   char message[SICM_ODE_MESSAGE_SIZE];
   void *backend;
