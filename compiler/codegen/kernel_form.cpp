@@ -1,6 +1,7 @@
 // Which form of a traced procedure's outputs a kernel computes (see kernel_form.hpp).
 #include "codegen/kernel_form.hpp"
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <unordered_set>
@@ -71,15 +72,35 @@ ExprId kernel_output_form(ExprId traced, ExprId simplified) {
   return dag_size({simplified}, limit + 1) > limit ? traced : simplified;
 }
 
-std::vector<ExprId> kernel_outputs(const gcvec<Value> &leaves,
-                                   const std::function<bool(ExprId)> &usable) {
+std::vector<bool> allowed_roots(const std::vector<ExprId> &roots, const NodeAllowed &allowed) {
+  std::vector<ExprId> nodes;
+  expr_visit(roots, [&](ExprId id) {
+    nodes.push_back(id);
+    return true;
+  });
+  std::sort(nodes.begin(), nodes.end());
+  std::unordered_set<ExprId> refused;
+  for (ExprId id : nodes) {
+    bool ok = allowed(id);
+    ExprKind kind = expr_kind(id);
+    if (ok && (kind == ExprKind::Apply || kind == ExprKind::Call))
+      for (ExprId a : expr_arg_vector(id))
+        ok = ok && !refused.count(a);
+    if (!ok) refused.insert(id);
+  }
+  std::vector<bool> out;
+  for (ExprId id : roots)
+    out.push_back(!refused.count(id));
+  return out;
+}
+
+std::vector<ExprId> kernel_outputs(const gcvec<Value> &leaves, const NodeAllowed &allowed) {
   std::vector<ExprId> traced;
   for (Value leaf : leaves)
     traced.push_back(leaf_expr(leaf));
   traced = rewrite_locally(traced);
-  bool all_usable = true;
-  for (ExprId id : traced)
-    all_usable = all_usable && usable(id);
+  std::vector<bool> usable = allowed_roots(traced, allowed);
+  bool all_usable = std::find(usable.begin(), usable.end(), false) == usable.end();
   if (all_usable &&
       (dag_size(traced, kMaxCanonicalizedNodes + 1) > kMaxCanonicalizedNodes ||
        denominators(traced, kMaxCanonicalizedDenominators + 1) > kMaxCanonicalizedDenominators))
@@ -92,7 +113,7 @@ std::vector<ExprId> kernel_outputs(const gcvec<Value> &leaves,
     if (all_usable) budget.emplace(kCanonicalizationBudget);
     for (size_t i = 0; i < leaves.size(); ++i) {
       ExprId s = leaf_expr(simplify_value(leaves[i]));
-      bool keep_traced = usable(traced[i]) && kernel_output_form(traced[i], s) == traced[i];
+      bool keep_traced = usable[i] && kernel_output_form(traced[i], s) == traced[i];
       simplified.push_back(keep_traced ? traced[i] : s);
     }
     to_evaluation_form(simplified);

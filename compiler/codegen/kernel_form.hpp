@@ -66,14 +66,21 @@ constexpr double kCanonicalAdvantage = 1.5;
 // accelerations of 8 bodies over one common denominator).
 constexpr size_t kCanonicalizationBudget = 200000;
 
+// Says whether a kernel may hold one node as it is: a symbol that stands
+// for an input (or, in sicm build, a run-time value), a solve node; a number
+// or an operation is always allowed, a literal function's call never.
+using NodeAllowed = std::function<bool(ExprId)>;
+
+// Which roots hold only allowed nodes, each judged once: one pass over the
+// whole DAG in id order (an argument's id is smaller than its user's).
+std::vector<bool> allowed_roots(const std::vector<ExprId> &roots, const NodeAllowed &allowed);
+
 // The outputs of a kernel, one per scalar leaf (a number, a symbol or an
-// expression: the caller has checked). `usable` says whether an output
-// expression refers only to the kernel's inputs (a traced form can still
-// hold what simplification cancels, such as a symbol times a zero
-// difference); a traced form that is not usable is replaced by the
-// simplified one whatever its size.
-std::vector<ExprId> kernel_outputs(const gcvec<Value> &leaves,
-                                   const std::function<bool(ExprId)> &usable);
+// expression: the caller has checked). A traced output that holds a node
+// `allowed` refuses (a traced form can still hold what simplification
+// cancels, such as a symbol times a zero difference) is replaced by its
+// simplified form whatever its size.
+std::vector<ExprId> kernel_outputs(const gcvec<Value> &leaves, const NodeAllowed &allowed);
 
 // The number of distinct nodes under the roots (numbers, symbols and
 // operations alike), counting up to `cap` at most.

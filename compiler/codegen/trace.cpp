@@ -109,12 +109,12 @@ bool collect_outputs(Value result, Trace *t, std::string *why_not) {
     return false;
   }
   std::unordered_set<Symbol *> inputs(t->inputs.begin(), t->inputs.end());
-  auto usable = [&](ExprId id) {
-    std::unordered_set<ExprId> seen;
-    std::string ignored;
-    return check_expression(id, inputs, seen, &ignored);
+  auto allowed = [&](ExprId id) {
+    ExprKind kind = expr_kind(id);
+    if (kind == ExprKind::Symbol) return inputs.count(expr_node(id).sym) > 0;
+    return kind != ExprKind::Call || is_solve_node(id);
   };
-  t->outputs = kernel_outputs(leaves, usable);
+  t->outputs = kernel_outputs(leaves, allowed);
   std::unordered_set<ExprId> seen;
   for (ExprId id : t->outputs)
     if (!check_expression(id, inputs, seen, why_not)) return false;

@@ -853,14 +853,12 @@ bool is_scalar_leaf(Value v) {
   return is_number(v) || is_dynamic_scalar(v);
 }
 
-// Does the expression refer to nothing but numbers and run-time values,
-// through operations and linear solves?
-bool only_run_time_values(ExprId root) {
-  return expr_visit({root}, [](ExprId id) {
-    const ExprNode &n = expr_node(id);
-    if (n.kind == ExprKind::Symbol) return g_var_of.count(n.sym) > 0;
-    return n.kind != ExprKind::Call || is_solve_node(id);
-  });
+// May a residual function hold this node? A symbol only if it is a
+// run-time value, a call only if it is a linear solve.
+bool run_time_node(ExprId id) {
+  const ExprNode &n = expr_node(id);
+  if (n.kind == ExprKind::Symbol) return g_var_of.count(n.sym) > 0;
+  return n.kind != ExprKind::Call || is_solve_node(id);
 }
 
 // A system derivative's leaves as the outputs of its kernel, in the form
@@ -869,9 +867,10 @@ bool only_run_time_values(ExprId root) {
 std::vector<ExprId> system_outputs(const gcvec<Value> &leaves, const char *who) {
   for (Value leaf : leaves)
     if (leaf_expr(leaf) == kNoExpr) expr_of(leaf, who); // raises: not a number
-  std::vector<ExprId> outputs = kernel_outputs(leaves, only_run_time_values);
+  std::vector<ExprId> outputs = kernel_outputs(leaves, run_time_node);
+  std::vector<bool> allowed = allowed_roots(outputs, run_time_node);
   for (size_t i = 0; i < outputs.size(); ++i)
-    if (!expr_is_number(outputs[i]) && !only_run_time_values(outputs[i]))
+    if (!allowed[i])
       cannot_compile(here(), std::string(who) + " needs a number here, not " + describe(leaves[i]));
   return outputs;
 }
