@@ -45,8 +45,8 @@
 #include "algebra/symbolic.hpp"
 #include "codegen/jit.hpp"
 #include "eval/number.hpp"
-#include "sicm/runtime.h"
 #include "syntax/error.hpp"
+#include "sicm/runtime.h"
 
 namespace sicm {
 
@@ -220,8 +220,8 @@ private:
       mpq_t q;
       mpq_init(q);
       to_mpq(v, q);
-      bool fits =
-          mpz_sizeinbase(mpq_numref(q), 2) + mpz_sizeinbase(mpq_denref(q), 2) <= kMaxConstantBits;
+      bool fits = mpz_sizeinbase(mpq_numref(q), 2) + mpz_sizeinbase(mpq_denref(q), 2) <=
+                  kMaxConstantBits;
       mpq_clear(q);
       return fits;
     };
