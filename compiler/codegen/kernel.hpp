@@ -5,12 +5,15 @@
 // one in three passes, each in its own file:
 //
 //   trace.cpp   apply the procedure to fresh symbols shaped like sample
-//               arguments, simplify each scalar leaf of the result
+//               arguments, put each scalar leaf of the result in its kernel
+//               form (kernel_form.hpp: the traced DAG rewritten locally, or
+//               a small kernel's canonical form when that pays)
 //               (requires: the procedure computes its result by generic
 //               arithmetic alone; produces: a Trace, the outputs as
 //               expressions over the input symbols)
 //   emit_c.cpp  the Trace as one C11 function with the kernel ABI, after CSE,
-//               powers as products and sin/cos pairs as sincos
+//               powers as products, sin/cos pairs as sincos and linear
+//               solves as LDL^T or LU factorizations
 //   jit.cpp     the C compiled by the system compiler into a shared object,
 //               cached by content hash, and loaded with dlopen
 //

@@ -3,8 +3,9 @@
 //
 // Requires: a procedure that computes its result from its arguments by generic
 // arithmetic (numbers it captures fold into constants). Produces: a Trace, one
-// simplified expression per scalar leaf of the result, over fresh uninterned
-// symbols x0, x1, ... that stand for the arguments' scalar leaves.
+// expression per scalar leaf of the result in the form kernel_outputs chooses
+// (codegen/kernel_form.hpp), over fresh uninterned symbols x0, x1, ... that
+// stand for the arguments' scalar leaves.
 //
 // Limits: a procedure that branches on an argument cannot be traced when the
 // test raises on a symbol (`<`, `positive?`), which is reported; but `=`,

@@ -876,9 +876,9 @@ std::vector<ExprId> system_outputs(const gcvec<Value> &leaves, const char *who) 
 }
 
 // Trace a system derivative on a state shaped like `state`; fills the
-// statement's callee, time_first and rate_one. The derivative is simplified,
-// as the interpreter's compiled derivatives are (evolve in `sicm run`
-// compiles the same kernel, so both compute the same numbers).
+// statement's callee, time_first and rate_one. The derivative takes the
+// form the interpreter's compiled derivatives take (kernel_outputs: evolve
+// in `sicm run` compiles the same kernel, so both compute the same numbers).
 void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
   if (!is_state_shape(state)) wrong_type(state, 1, who);
   FunctionScope scope(procedure_name(sysder));
