@@ -4,6 +4,8 @@
 #   make check      install missing Debian packages, build, run every test
 #   make demo       install missing Debian packages, build, compile an example
 #                   scene with sicm build and run it (writes its SVG)
+#   make stability  run the hard cases of tests/stability/ at full size, built,
+#                   and write docs/stability.md
 #   make examples   build every figure scene at full size with sicm build,
 #                   run it, and write its plot into build/figures
 #   make install    install sicm under $(PREFIX)
@@ -56,7 +58,7 @@ SICM    := $(BUILD)/sicm
 RTLIB   := $(BUILD)/libsicmrt.a
 UNITBIN := $(BUILD)/unit-tests
 
-.PHONY: all check demo examples install clean deps unit fuzz-smoke
+.PHONY: all check demo examples stability install clean deps unit fuzz-smoke
 all: $(SICM) $(RTLIB)
 
 $(BUILD)/%.o: %.cpp
@@ -131,6 +133,12 @@ demo: deps
 	$(SICM) build examples/driven-pendulum.sicm -o $(BUILD)/demo/driven-pendulum
 	$(BUILD)/demo/driven-pendulum --plot-dir $(BUILD)/demo
 	@echo "plot: $(BUILD)/demo/driven-pendulum.svg (data: $(BUILD)/demo/driven-pendulum.tsv)"
+
+# The hard cases at full size, built; writes docs/stability.md (never edit it
+# by hand) and fails if a bound does not hold.
+stability: deps
+	@$(MAKE) --no-print-directory all
+	@scripts/stability-report --sicm $(SICM)
 
 # Every figure scene at full size, built with sicm build and run, into
 # $(BUILD)/figures (scripts/run-examples without --build interprets them).
