@@ -9,6 +9,7 @@
 #include "algebra/symbolic.hpp"
 #include "codegen/emit_c.hpp"
 #include "codegen/evaluation_form.hpp"
+#include "codegen/half_angle.hpp"
 #include "codegen/local_rewrite.hpp"
 #include "eval/limits.hpp"
 #include "eval/number.hpp"
@@ -98,7 +99,7 @@ std::vector<ExprId> kernel_outputs(const gcvec<Value> &leaves, const NodeAllowed
   std::vector<ExprId> traced;
   for (Value leaf : leaves)
     traced.push_back(leaf_expr(leaf));
-  traced = rewrite_locally(traced);
+  traced = rewrite_half_angles(rewrite_locally(traced));
   std::vector<bool> usable = allowed_roots(traced, allowed);
   bool all_usable = std::find(usable.begin(), usable.end(), false) == usable.end();
   if (all_usable &&
@@ -117,6 +118,7 @@ std::vector<ExprId> kernel_outputs(const gcvec<Value> &leaves, const NodeAllowed
       simplified.push_back(keep_traced ? traced[i] : s);
     }
     to_evaluation_form(simplified);
+    simplified = rewrite_half_angles(simplified);
   } catch (const Error &) {
     if (!all_usable) throw;
     return traced;
