@@ -114,6 +114,27 @@ static int fail(const sicm_symplectic_type *T, int status, size_t ndof, double t
   return sicm_error(status, "%s", msg);
 }
 
+/* x += dx by compensated summation (Hairer, Lubich & Wanner, Geometric
+ * Numerical Integration, VIII.5): *err holds what rounding has so far left
+ * out of x and goes in with the next increment, so that the roundings of
+ * millions of small increments to a large x do not random-walk (over 6e7
+ * yoshida4 steps of a Kepler orbit they moved the angular momentum, which
+ * the methods conserve exactly, by 1.6e-12; compensated, by 2e-16). A
+ * Kepler step costs 10 to 15% more. x stays the rounded value of the sum. */
+static void add_compensated(double *x, double *err, double dx) {
+  const double before = *x;
+  *err += dx;
+  *x = before + *err;
+  *err += before - *x;
+}
+
+/* Scratch of a run of steps: the callbacks' results, and the compensations
+ * of q and p (add_compensated), carried from step to step. */
+typedef struct {
+  double *force, *velocity;
+  double *q_err, *p_err;
+} step_scratch;
+
 /* One composed step of size dt from time t: q, p advance in place. On entry
  * *pending is the coefficient (times dt) of a kick still owed at (t, q); on
  * exit it is the coefficient owed at the end of the step. The first force
@@ -121,24 +142,24 @@ static int fail(const sicm_symplectic_type *T, int status, size_t ndof, double t
  * applied), which is stored in proper_p (q itself is proper) for error
  * recovery; *have_proper says whether that happened. */
 static int step(const double *w, int stages, size_t ndof, sicm_force dVdq, sicm_velocity dTdp,
-                void *params, double t, double dt, double *q, double *p, double *force,
-                double *velocity, double *pending, double *proper_p, int *have_proper) {
+                void *params, double t, double dt, double *q, double *p, const step_scratch *sc,
+                double *pending, double *proper_p, int *have_proper) {
   double tau = t;
   *have_proper = 0;
   for (int s = 0; s < stages; s++) {
-    const double kick = (*pending + 0.5 * w[s]) * dt;
-    if (dVdq(tau, q, force, params)) return SICM_EUSER;
+    const double kick = (*pending + 0.5 * w[s]) * dt, drift = w[s] * dt;
+    if (dVdq(tau, q, sc->force, params)) return SICM_EUSER;
     if (s == 0) {
       for (size_t i = 0; i < ndof; i++)
-        proper_p[i] = p[i] - *pending * dt * force[i];
+        proper_p[i] = p[i] - *pending * dt * sc->force[i];
       *have_proper = 1;
     }
     for (size_t i = 0; i < ndof; i++)
-      p[i] -= kick * force[i];
-    if (dTdp(p, velocity, params)) return SICM_EUSER;
+      add_compensated(&p[i], &sc->p_err[i], -kick * sc->force[i]);
+    if (dTdp(p, sc->velocity, params)) return SICM_EUSER;
     for (size_t i = 0; i < ndof; i++)
-      q[i] += w[s] * dt * velocity[i];
-    tau += w[s] * dt;
+      add_compensated(&q[i], &sc->q_err[i], drift * sc->velocity[i]);
+    tau += drift;
     *pending = 0.5 * w[s];
   }
   return SICM_SUCCESS;
@@ -200,16 +221,16 @@ static int run_steps(const sicm_symplectic_type *T, size_t ndof, sicm_force dVdq
 
   double w[kMaxStages];
   weights(T, w);
-  /* force, velocity: scratch for the callbacks. good_q, good_p, good_t: the
-   * last proper state known, which the caller gets back if a step fails.
-   * start_q: q at the start of the current step. */
-  double *scratch = malloc(5 * ndof * sizeof *scratch);
+  /* sc: scratch for the callbacks and the compensations, which start at 0.
+   * good_q, good_p, good_t: the last proper state known, which the caller
+   * gets back if a step fails. start_q: q at the start of the current step. */
+  double *scratch = calloc(7 * ndof, sizeof *scratch);
   if (!scratch) {
     out->what = out->detail = "out of memory";
     return SICM_ENOMEM;
   }
-  double *force = scratch, *velocity = force + ndof, *good_q = velocity + ndof;
-  double *good_p = good_q + ndof, *start_q = good_p + ndof;
+  const step_scratch sc = {scratch, scratch + ndof, scratch + 2 * ndof, scratch + 3 * ndof};
+  double *good_q = scratch + 4 * ndof, *good_p = good_q + ndof, *start_q = good_p + ndof;
   memcpy(good_q, q, ndof * sizeof *q);
   memcpy(good_p, p, ndof * sizeof *p);
   double good_t = t0, pending = 0;
@@ -218,8 +239,8 @@ static int run_steps(const sicm_symplectic_type *T, size_t ndof, sicm_force dVdq
     const double tstart = t0 + (double)i * dt;
     int have_proper = 0;
     memcpy(start_q, q, ndof * sizeof *q);
-    status = step(w, T->stages, ndof, dVdq, dTdp, params, tstart, dt, q, p, force, velocity,
-                  &pending, good_p, &have_proper);
+    status = step(w, T->stages, ndof, dVdq, dTdp, params, tstart, dt, q, p, &sc, &pending, good_p,
+                  &have_proper);
     if (have_proper) { /* good_p was just set to the proper momentum at tstart */
       memcpy(good_q, start_q, ndof * sizeof *q);
       good_t = tstart;
@@ -229,9 +250,9 @@ static int run_steps(const sicm_symplectic_type *T, size_t ndof, sicm_force dVdq
     if (status == SICM_SUCCESS) out->steps++;
   }
   if (status == SICM_SUCCESS) { /* pay the last half kick at t1 */
-    if (dVdq(t1, q, force, params) == 0) {
+    if (dVdq(t1, q, sc.force, params) == 0) {
       for (size_t k = 0; k < ndof; k++)
-        p[k] -= pending * dt * force[k];
+        add_compensated(&p[k], &sc.p_err[k], -pending * dt * sc.force[k]);
       *t = t1;
     } else {
       status = SICM_EUSER;

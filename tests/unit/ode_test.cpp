@@ -406,6 +406,49 @@ TEST(Symplectic, KeplerEnergyStaysBoundedOver1000Periods) {
   EXPECT_LT(last, 1.5 * first);
 }
 
+// Angular momentum L = q x p of a Kepler orbit (GM = 1) is conserved exactly by every
+// splitting method (kicks are parallel to q, drifts to p), so what changes it is rounding. The
+// force callback remembers q; the velocity callback, which comes next with the kicked p, takes
+// the largest |L - L0| seen along the way.
+struct AngularMomentumWatch {
+  double q[2];
+  double L0, max_error;
+};
+
+int watched_kepler_force(double t, const double *q, double *f, void *w) {
+  auto *watch = static_cast<AngularMomentumWatch *>(w);
+  watch->q[0] = q[0], watch->q[1] = q[1];
+  return kepler_force(t, q, f, nullptr);
+}
+
+int watched_velocity(const double *p, double *v, void *w) {
+  auto *watch = static_cast<AngularMomentumWatch *>(w);
+  v[0] = p[0], v[1] = p[1];
+  const double L = watch->q[0] * p[1] - watch->q[1] * p[0];
+  watch->max_error = std::fmax(watch->max_error, std::fabs(L - watch->L0));
+  return 0;
+}
+
+TEST(Symplectic, CompensatedSummationKeepsAngularMomentum) {
+  const double e = 0.5, period = 2 * M_PI, h = period / 10000;
+  const double steps = 2e6; // 200 periods in one call
+  double q[2] = {1 - e, 0}, p[2] = {0, std::sqrt((1 + e) / (1 - e))}, t = 0;
+  AngularMomentumWatch watch = {{0, 0}, q[0] * p[1] - q[1] * p[0], 0};
+  ASSERT_EQ(sicm_symplectic_evolve(sicm_symplectic_verlet, 2, watched_kepler_force,
+                                   watched_velocity, &watch, &t, 200 * period, h, q, p),
+            SICM_SUCCESS);
+  // Each step adds h F to p and h v to q. Added plainly, each sum is rounded to an ulp of q or
+  // p, so L random-walks by about eps |q| |p| = eps |L| a step, eps |L| sqrt(steps) in all.
+  // Compensated, only the roundings of the increments themselves remain, about
+  // eps h (|q| |F| + |p| |v|) <= eps h S a step with S = 1/r + v^2, 5 at periapsis, which walk to
+  // eps h S sqrt(steps); add a few ulps of L for the last rounding of q and p and for
+  // computing L. Measured: 2.2e-16 compensated, 5.1e-14 plain (0.19 eps |L| sqrt(steps)).
+  const double eps = 2.220446049250313e-16, S = 5;
+  const double bound = 4 * eps * (std::fabs(watch.L0) + h * S * std::sqrt(steps)); // 4.7e-15
+  EXPECT_LT(watch.max_error, bound);
+  EXPECT_NEAR(t, 200 * period, 1e-12);
+}
+
 int stop_force(double t, const double *q, double *f, void *) {
   f[0] = q[0];
   return t > 1 ? 3 : 0;
