@@ -709,6 +709,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   apply_procedure(monitor, &state, 1);
   RuntimeErrorScope scope;
   OdePtr ode = p.make_integrator(T, eps);
+  sicm_ode_set_horizon(ode.get(), t_final);
   double t = p.t0;
   ProgressBar progress(p.t0, t_final);
   for (long k = 1; std::fabs(t_final - t) > 0; ++k) {

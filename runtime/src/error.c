@@ -45,6 +45,7 @@ const char *sicm_strerror(int status) {
   case SICM_ECONV: return "convergence failure";
   case SICM_EFAILED: return "failure in a numerical library";
   case SICM_ESINGULAR: return "singular matrix in a linear solve";
+  case SICM_ESTIFF: return "stiff system: use an implicit method";
   }
   return "unknown status";
 }

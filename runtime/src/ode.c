@@ -106,8 +106,7 @@ double sicm_ode_error_norm(const sicm_ode *o, const double *err, const double *y
   return m;
 }
 
-/* Root-mean-square of v_i / (abs_tol + rel_tol |y_i|). */
-static double rms_scaled(const sicm_ode *o, const double *v, const double *y) {
+double sicm_ode_rms_scaled(const sicm_ode *o, const double *v, const double *y) {
   double s = 0;
   for (size_t i = 0; i < o->dim; i++) {
     double r = v[i] / (o->abs_tol + o->rel_tol * fabs(y[i]));
@@ -120,7 +119,7 @@ double sicm_ode_initial_step(sicm_ode *o, double t, const double *y, const doubl
                              int order, double *work, int *status) {
   const size_t n = o->dim;
   const double dir = t1 > t ? 1.0 : -1.0;
-  double d0 = rms_scaled(o, y, y), d1 = rms_scaled(o, f0, y);
+  double d0 = sicm_ode_rms_scaled(o, y, y), d1 = sicm_ode_rms_scaled(o, f0, y);
   double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
   h0 = fmin(h0, fabs(t1 - t));
   double *y1 = work, *f1 = work + n;
@@ -134,7 +133,7 @@ double sicm_ode_initial_step(sicm_ode *o, double t, const double *y, const doubl
   if (*status != SICM_SUCCESS) return 0;
   for (size_t i = 0; i < n; i++)
     f1[i] -= f0[i];
-  double d2 = rms_scaled(o, f1, y) / h0;
+  double d2 = sicm_ode_rms_scaled(o, f1, y) / h0;
   double dmax = fmax(d1, d2);
   double h1 = dmax <= 1e-15 ? fmax(1e-6, h0 * 1e-3) : pow(0.01 / dmax, 1.0 / (order + 1));
   return dir * fmin(100 * h0, h1);
@@ -203,6 +202,12 @@ int sicm_ode_fail_max_steps(sicm_ode *o, double t, const double *y) {
  * GSL_EBADFUNC (GSL stops at once), non-finite values GSL_FAILURE (GSL
  * halves the step and retries, down to the resolution of t). */
 typedef struct {
+  const gsl_odeiv2_step_type *const *step;
+  sicm_ode_stability stability; /* {0, 0}: implicit (msbdf), not watched */
+} gsl_method;
+
+typedef struct {
+  const gsl_method *method;
   gsl_odeiv2_system sys;
   gsl_odeiv2_driver *driver;
   double *save; /* y before the current step */
@@ -229,10 +234,12 @@ static int gsl_jacobian(double t, const double y[], double *dfdy, double dfdt[],
 }
 
 static int gsl_init(sicm_ode *o) {
-  const gsl_odeiv2_step_type *T = *(const gsl_odeiv2_step_type *const *)o->type->data;
+  const gsl_method *method = o->type->data;
+  const gsl_odeiv2_step_type *T = *method->step;
   gsl_backend *b = calloc(1, sizeof *b);
   if (!b) return SICM_ENOMEM;
   o->backend = b;
+  b->method = method;
   b->sys = (gsl_odeiv2_system){gsl_rhs, gsl_jacobian, o->dim, o};
   b->save = malloc(o->dim * sizeof *b->save);
   b->work = malloc(3 * o->dim * sizeof *b->work);
@@ -315,19 +322,36 @@ static int gsl_evolve(sicm_ode *o, double *t, double t1, double *y) {
     }
     o->stats.steps++;
     o->h = h; /* GSL leaves h alone after a step shortened to land on t1 */
+    if (b->method->stability.real > 0) {
+      s = sicm_ode_watch_stiffness(o, *t, y, *t - t0, t1, b->method->stability);
+      if (s != SICM_SUCCESS) return s;
+    }
   }
   return SICM_SUCCESS;
 }
 
-#define GSL_STEP_TYPE(var, label, gsl_type)                                                        \
+#define GSL_STEP_TYPE(var, label, gsl_type, real, imaginary)                                       \
+  static const gsl_method var##_method = {&gsl_type, {real, imaginary}};                           \
   static const sicm_ode_step_type var##_type = {label,     gsl_init, gsl_evolve,                   \
-                                                gsl_reset, gsl_free, &gsl_type};                   \
+                                                gsl_reset, gsl_free, &var##_method};               \
   const sicm_ode_step_type *const sicm_ode_step_##var = &var##_type;
 
-GSL_STEP_TYPE(rk8pd, "rk8pd", gsl_odeiv2_step_rk8pd)
-GSL_STEP_TYPE(rkf45, "rkf45", gsl_odeiv2_step_rkf45)
-GSL_STEP_TYPE(rkck, "rkck", gsl_odeiv2_step_rkck)
-GSL_STEP_TYPE(msbdf, "msbdf", gsl_odeiv2_step_msbdf)
+/* The stability boundaries of GSL's explicit steppers (sicm_ode_stability),
+ * measured: one step of the stepper itself from y = 1 on y' = lambda y
+ * (written as a real 2x2 system) gives |R(h lambda)| exactly; scanning
+ * |h lambda| upwards in steps of 1e-3 along each axis, the boundary is where
+ * |R| first exceeds 1 + 1e-3. On the negative real axis |R| <= 1 holds up to
+ * there (5.17, 3.68, 3.73). On the imaginary axis rkf45 and rkck, which
+ * advance with their 5th-order formulas, grow slightly for any step
+ * (|R| - 1 is 1e-5 at 0.5 for rkf45); the slack of 1e-3 a step is what
+ * their error control absorbs at a loose tolerance. As a
+ * check, each controller integrating y' = lambda y, |lambda| = 1000, from a
+ * tiny start at tolerances 1e-3 to 1e-13 holds h |lambda| at 5.20 and 3.70
+ * (rk8pd), 3.69 and 3.52 (rkf45), 3.74 and 0.80 (rkck). */
+GSL_STEP_TYPE(rk8pd, "rk8pd", gsl_odeiv2_step_rk8pd, 5.17, 3.78)
+GSL_STEP_TYPE(rkf45, "rkf45", gsl_odeiv2_step_rkf45, 3.68, 1.09)
+GSL_STEP_TYPE(rkck, "rkck", gsl_odeiv2_step_rkck, 3.73, 1.25)
+GSL_STEP_TYPE(msbdf, "msbdf", gsl_odeiv2_step_msbdf, 0, 0)
 
 const sicm_ode_step_type *const sicm_ode_step_bs = &sicm_ode_bs_type;
 const sicm_ode_step_type *const sicm_ode_step_cvode_adams = &sicm_ode_cvode_adams_type;
@@ -388,6 +412,7 @@ void sicm_ode_free(sicm_ode *o) {
   if (!o) return;
   if (o->backend) o->type->free(o);
   free(o->y_last);
+  free(o->stiffness_work);
   free(o);
 }
 
@@ -408,6 +433,10 @@ int sicm_ode_set_max_steps(sicm_ode *o, unsigned long max_steps) {
 void sicm_ode_reset(sicm_ode *o) {
   o->h = 0;
   o->have_last = 0;
+  o->steps_since_check = 0;
+  o->span_since_check = 0;
+  o->stiff_streak = 0;
+  o->have_vector = 0;
   gsl_error_handler_t *old = gsl_set_error_handler_off();
   o->type->reset(o);
   gsl_set_error_handler(old);
@@ -474,6 +503,11 @@ int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y) {
   o->t_last = t1;
   memcpy(o->y_last, y, o->dim * sizeof *y);
   return SICM_SUCCESS;
+}
+
+void sicm_ode_set_horizon(sicm_ode *o, double t_end) {
+  o->horizon_set = isfinite(t_end);
+  o->horizon = t_end;
 }
 
 const sicm_ode_stats *sicm_ode_get_stats(const sicm_ode *o) {

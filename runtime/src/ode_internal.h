@@ -57,6 +57,19 @@ struct sicm_ode {
   sicm_ode_stats stats;
   char message[SICM_ODE_MESSAGE_SIZE];
   void *backend;
+
+  /* The stiffness watch of the explicit methods (sicm_ode_watch_stiffness):
+   * accepted steps since its last check and the time they covered, how
+   * many checks in a row found the step held by stability, and its scratch
+   * (NULL until the first check), which begins with the power iteration's
+   * vector (have_vector: valid). */
+  int horizon_set; /* sicm_ode_set_horizon: where the caller is going */
+  double horizon;
+  unsigned long steps_since_check;
+  double span_since_check;
+  int stiff_streak;
+  int have_vector;
+  double *stiffness_work;
 };
 
 /* Results of sicm_ode_call_rhs and sicm_ode_call_jacobian, besides
@@ -76,6 +89,10 @@ int sicm_ode_call_jacobian(sicm_ode *o, double t, const double *y, double *dfdy,
 double sicm_ode_initial_step(sicm_ode *o, double t, const double *y, const double *f0, double t1,
                              int order, double *work, int *status);
 
+/* sicm_ode_rms_scaled returns the root-mean-square of v_i / (abs_tol +
+ * rel_tol |y_i|): the size of v against the tolerances. */
+double sicm_ode_rms_scaled(const sicm_ode *o, const double *v, const double *y);
+
 /* sicm_ode_error_norm returns max_i |err_i| / (abs_tol + rel_tol |y_i|):
  * the step is acceptable when it is at most 1. */
 double sicm_ode_error_norm(const sicm_ode *o, const double *err, const double *y);
@@ -89,6 +106,24 @@ int sicm_ode_fail(sicm_ode *o, int status, double t, const double *y, const char
 /* The messages of the usual failures, shared so all backends say the same. */
 int sicm_ode_fail_user(sicm_ode *o, double t, const double *y);
 int sicm_ode_fail_max_steps(sicm_ode *o, double t, const double *y);
+
+/* Where an explicit method is stable on y' = lambda y: the largest |h lambda|
+ * on the negative real axis and on the imaginary axis up to which the
+ * method's amplification |R(h lambda)| stays within 1 + 1e-3 per step. */
+typedef struct {
+  double real, imaginary;
+} sicm_ode_stability;
+
+/* sicm_ode_watch_stiffness is called by the explicit backends after each
+ * accepted step, of size h, that ended at (t, y) on the way to t1; stability
+ * is that of the method as used for the step. Now and then it estimates the
+ * fastest rate of the system (a few rhs calls, counted in the statistics)
+ * and, when the step has been held at the method's stability limit for a
+ * while and t1 is still far, fails with SICM_ESTIFF through sicm_ode_fail,
+ * naming an implicit method. Returns SICM_SUCCESS or that status. The
+ * implicit methods (msbdf, CVODE) are not watched. */
+int sicm_ode_watch_stiffness(sicm_ode *o, double t, const double *y, double h, double t1,
+                             sicm_ode_stability stability);
 
 /* All components finite? */
 int sicm_ode_finite(size_t n, const double *v);

@@ -411,6 +411,7 @@ void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_cl
   if (monitor.fn) monitor.fn(y, NULL, monitor.p);
   integrator it;
   open_integrator(site, who, ode, &it);
+  sicm_ode_set_horizon(it.o, t_final);
   double t = t0;
   for (long k = 1; fabs(t_final - t) > 0; ++k) {
     double tk = t0 + (double)k * step;

@@ -12,17 +12,18 @@ extern "C" {
  * `status != SICM_SUCCESS` and still tell the causes apart. */
 enum {
   SICM_SUCCESS = 0,
-  SICM_EINVAL = 1,    /* an argument is invalid (bad interval, dimension, tolerance) */
-  SICM_ENOMEM = 2,    /* memory could not be allocated */
-  SICM_EBADFUNC = 3,  /* a user function produced a non-finite value (NaN or infinity) */
-  SICM_EUSER = 4,     /* a user function returned non-zero to stop the computation */
-  SICM_ESTEP = 5,     /* the step size became too small to make progress */
-  SICM_EMAXITER = 6,  /* the allowed number of steps or iterations was exhausted */
-  SICM_ETOL = 7,      /* the requested tolerance cannot be reached */
-  SICM_EBRACKET = 8,  /* the interval does not bracket a root */
-  SICM_ECONV = 9,     /* an inner iteration (Newton, linear solve) failed to converge */
-  SICM_EFAILED = 10,  /* any other failure of an underlying library */
-  SICM_ESINGULAR = 11 /* a linear solve in a user function met a singular matrix */
+  SICM_EINVAL = 1,     /* an argument is invalid (bad interval, dimension, tolerance) */
+  SICM_ENOMEM = 2,     /* memory could not be allocated */
+  SICM_EBADFUNC = 3,   /* a user function produced a non-finite value (NaN or infinity) */
+  SICM_EUSER = 4,      /* a user function returned non-zero to stop the computation */
+  SICM_ESTEP = 5,      /* the step size became too small to make progress */
+  SICM_EMAXITER = 6,   /* the allowed number of steps or iterations was exhausted */
+  SICM_ETOL = 7,       /* the requested tolerance cannot be reached */
+  SICM_EBRACKET = 8,   /* the interval does not bracket a root */
+  SICM_ECONV = 9,      /* an inner iteration (Newton, linear solve) failed to converge */
+  SICM_EFAILED = 10,   /* any other failure of an underlying library */
+  SICM_ESINGULAR = 11, /* a linear solve in a user function met a singular matrix */
+  SICM_ESTIFF = 12     /* stiff: stability, not accuracy, holds an explicit method's step */
 };
 
 /* The NaN that a compiled kernel writes into every output when a linear

@@ -168,8 +168,21 @@ int sicm_ode_set_max_steps(sicm_ode *o, unsigned long max_steps);
  * (times and components are printed as the compiler prints numbers; at most
  * 16 components are shown).
  *
+ * The explicit methods (rk8pd, rkf45, rkck, bs) watch for stiffness: when
+ * their step has been held by the method's stability, not by the tolerance,
+ * for some 800 steps and reaching t1 would take more than 1e5 further steps,
+ * they stop with SICM_ESTIFF, saying so and naming cvode-bdf. A short run is
+ * never stopped; a loop of short evolve calls is counted to its horizon
+ * (sicm_ode_set_horizon).
+ *
  * The same message goes to the error hook. */
 int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y);
+
+/* sicm_ode_set_horizon tells the integrator that the caller will go on
+ * calling sicm_ode_evolve towards t_end (a loop that stops every dt to
+ * monitor the state): the stiffness watch then judges the work left to
+ * t_end, not to the end of the current call. */
+void sicm_ode_set_horizon(sicm_ode *o, double t_end);
 
 /* sicm_ode_reset makes the next sicm_ode_evolve start afresh: the step size is
  * chosen again and multistep history is discarded. Statistics are kept. */
