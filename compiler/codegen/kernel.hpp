@@ -52,6 +52,11 @@ struct Kernel {
   std::string c_name;   // the C function's name (generated, [A-Za-z0-9_] only)
   std::string c_source; // the whole translation unit given to the C compiler
   std::string so_path;  // the shared object in the cache
+  // For a system derivative compiled with probe_singularities: a function
+  // of the same inputs computing what the kernel divides by
+  // (codegen/singular_factors.hpp), one value per text; null if nothing.
+  KernelFn singular_factors = nullptr;
+  std::vector<std::string> singular_texts;
 };
 
 // Compile `proc` for arguments shaped like `sample_args` (a Scheme list with
@@ -62,7 +67,11 @@ struct Kernel {
 // procedure raises while it is traced are caught and become the reason.
 // The procedure runs twice: once on symbols, once at the sample arguments to
 // check the kernel, so its side effects happen then, not when the kernel runs.
-Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not);
+// With probe_singularities (for a system derivative, whose one argument is
+// the state), the kernel also gets its singular factors, named by their
+// place in the state ((ref state 1 0)).
+Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not,
+                       bool probe_singularities = false);
 
 // Called with every kernel compile_kernel makes (sicm emit-c lists them);
 // null (the default) for none.

@@ -104,6 +104,7 @@ struct RStmt {
   int callee = -1;          // the function a numerical statement calls
   int monitor = -1;         // Evolve: the monitor function, or -1
   int jacobian = -1;        // Advance, Evolve: (D sysder) for implicit methods
+  int probe = -1;           // Advance, Evolve: what sysder divides by, or -1
   int cell = -1;            // SetCell, Let of ReadCell
   int list = -1;            // ListNew, ListPush, Let of ListLength, ListRef, ListFold
   int leaf = 0;             // Let of ListRef, ListFold; ListConst: the table
@@ -112,6 +113,7 @@ struct RStmt {
   bool time_first = false, rate_one = false; // Advance, Evolve
   std::string method;                        // Advance, Evolve: the runtime's step type variable
   std::string text, title;
+  std::vector<std::string> probe_texts;    // Advance, Evolve: the probe's outputs as text
   SrcLoc loc;                              // the call, for run-time errors
   std::vector<RStmt> then_body, else_body; // If
 };

@@ -213,7 +213,7 @@ private:
       if (s.kind == RKind::Print) needs.insert(s.var);
       for (ExprId a : s.args)
         refs_of(a, &s, needs);
-      for (int callee : {s.callee, s.monitor, s.jacobian})
+      for (int callee : {s.callee, s.monitor, s.jacobian, s.probe})
         if (callee >= 0) needs.insert(captures_[callee].begin(), captures_[callee].end());
       live.insert(needs.begin(), needs.end());
       used.insert(needs.begin(), needs.end());
@@ -262,6 +262,18 @@ private:
 
   // ---- pass 2: emission ----
 
+  // The texts of a system derivative's singular factors, as a static array
+  // of C strings (escaped: they may hold the names of parameters).
+  std::string probe_texts(const std::vector<std::string> &texts) {
+    if (texts.empty()) return "NULL";
+    std::string name = "singular" + std::to_string(nprobes_++);
+    sites_ += "static const char *const " + name + "[] = {";
+    for (size_t i = 0; i < texts.size(); ++i)
+      sites_ += (i ? ", " : "") + c_string_literal(texts[i]);
+    sites_ += "};\n";
+    return name;
+  }
+
   std::string site(const SrcLoc &loc) {
     std::string name = "site" + std::to_string(nsites_++);
     std::string where = loc.known() ? source_name(loc.file) + ":" + std::to_string(loc.line) + ":" +
@@ -305,7 +317,8 @@ private:
   std::string ode(const RStmt &s, size_t dim) {
     return "(sicm_drive_ode){" + s.method + ", " + closure(s.callee) + ", " + std::to_string(dim) +
            ", " + (s.time_first ? "1" : "0") + ", " + (s.rate_one ? "1" : "0") + ", " +
-           c_double_literal(s.number) + ", " + closure(s.jacobian) + "}";
+           c_double_literal(s.number) + ", " + closure(s.jacobian) + ", " + closure(s.probe) +
+           ", " + std::to_string(s.probe_texts.size()) + ", " + probe_texts(s.probe_texts) + "}";
   }
 
   // The used outputs of a statement from an array: declared here, or assigned
@@ -605,6 +618,7 @@ private:
   std::map<Symbol *, int> var_ids_;
   std::string sites_;
   int nsites_ = 0;
+  int nprobes_ = 0;
 };
 
 } // namespace

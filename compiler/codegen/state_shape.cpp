@@ -29,6 +29,26 @@ void state_leaves(Value v, gcvec<Value> &out) {
     state_leaves(items[i], out);
 }
 
+namespace {
+void leaf_paths(Value v, const std::string &indices, const std::string &root,
+                std::vector<std::string> &out) {
+  size_t len;
+  Value *items = container_items(v, &len);
+  if (!items) {
+    out.push_back(indices.empty() ? root : "(ref " + root + indices + ")");
+    return;
+  }
+  for (size_t i = 0; i < len; ++i)
+    leaf_paths(items[i], indices + " " + std::to_string(i), root, out);
+}
+} // namespace
+
+std::vector<std::string> state_leaf_paths(Value v, const std::string &root) {
+  std::vector<std::string> out;
+  leaf_paths(v, "", root, out);
+  return out;
+}
+
 size_t state_dimension(Value v) {
   gcvec<Value> leaves;
   state_leaves(v, leaves);

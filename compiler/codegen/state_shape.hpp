@@ -9,6 +9,8 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
+#include <vector>
 
 #include "eval/value.hpp"
 
@@ -20,6 +22,10 @@ Value *container_items(Value v, size_t *len);
 // v's leaves (what is not a container), depth first.
 void state_leaves(Value v, gcvec<Value> &out);
 size_t state_dimension(Value v);
+
+// How a program names each of v's leaves, in state_leaves' order: `root`
+// for a leaf, else (ref root i j ...) (vectors too: ref reads them).
+std::vector<std::string> state_leaf_paths(Value v, const std::string &root);
 
 // A container shaped like `shape` (structures keep their orientation,
 // vectors stay vectors) whose parts are part(item, leaves) of its items in

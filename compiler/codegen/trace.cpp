@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "algebra/linear_solve.hpp"
@@ -21,6 +22,7 @@
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
 #include "codegen/kernel_form.hpp"
+#include "codegen/singular_factors.hpp"
 #include "codegen/state_shape.hpp"
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
@@ -238,7 +240,8 @@ void set_kernel_listener(KernelListener listener) {
   g_kernel_listener = listener;
 }
 
-Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not) {
+Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not,
+                       bool probe_singularities) {
   std::string ignored;
   if (!why_not) why_not = &ignored;
   std::string kname = name ? name : procedure_name(proc);
@@ -246,9 +249,27 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   if (!trace_procedure(proc, sample_args, &t, why_not)) return nullptr;
   std::string c_name = c_kernel_name(kname);
   std::string source = emit_kernel_unit(t, c_name, kname);
+  SingularFactors factors;
+  std::string probe_name = c_name + "_singular_factors";
+  if (probe_singularities && list_length(sample_args) == 1) {
+    std::vector<std::string> paths = state_leaf_paths(car(sample_args), "state");
+    std::unordered_map<Symbol *, std::string> names;
+    for (size_t i = 0; i < t.inputs.size() && i < paths.size(); ++i)
+      names[t.inputs[i]] = paths[i];
+    factors = singular_factors(t.outputs, [&](Symbol *s) {
+      auto it = names.find(s);
+      return it == names.end() ? std::string() : it->second;
+    });
+    if (!factors.values.empty()) {
+      Trace probe{t.inputs, factors.values, Value::fixnum(0)};
+      source += "\nvoid " + probe_name + "(const double *in, double *out, const double *p);\n\n";
+      source += emit_kernel_function(probe, probe_name, false);
+    }
+  }
   std::string so;
   void *fn = jit_load(source, c_name, &so, why_not);
   if (!fn) return nullptr;
+  void *probe_fn = factors.values.empty() ? nullptr : jit_load(source, probe_name, &so, why_not);
   Kernel *k = gc_new<Kernel>();
   // ignore_self: a std::string member may point into the object (its short-string buffer).
   GC_register_finalizer_ignore_self(k, finalize_kernel, nullptr, nullptr, nullptr);
@@ -261,6 +282,8 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   k->c_name = c_name;
   k->c_source = std::move(source);
   k->so_path = so;
+  k->singular_factors = reinterpret_cast<KernelFn>(probe_fn);
+  if (probe_fn) k->singular_texts = std::move(factors.texts);
   if (!agrees_at_sample(k, proc, sample_args, why_not)) return nullptr;
   if (g_kernel_listener) g_kernel_listener(k);
   return k;

@@ -48,6 +48,7 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "codegen/kernel_form.hpp"
+#include "codegen/singular_factors.hpp"
 #include "codegen/state_shape.hpp"
 #include "codegen/trace.hpp"
 #include "eval/core.hpp"
@@ -900,6 +901,33 @@ void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
       expr_is_exact_one(d0) || (expr_kind(d0) == ExprKind::Flonum && expr_node(d0).d == 1.0);
 }
 
+// What the system derivative divides by, as a function of its own inputs
+// (the same state's leaves), for the runtime to name where an integration
+// fails (codegen/singular_factors.hpp).
+void trace_singular_factors(Value state, RStmt &s) {
+  std::vector<Symbol *> from;
+  for (int v : g_prog->functions[s.callee].inputs)
+    from.push_back(g_prog->vars[v].sym);
+  std::vector<std::string> paths = state_leaf_paths(state, "state");
+  std::unordered_map<Symbol *, std::string> names;
+  for (size_t i = 0; i < from.size() && i < paths.size(); ++i)
+    names[from[i]] = paths[i];
+  SingularFactors factors =
+      singular_factors(g_prog->functions[s.callee].outputs, [&](Symbol *sym) {
+        auto it = names.find(sym);
+        return it == names.end() ? std::string() : it->second;
+      });
+  if (factors.values.empty()) return;
+  FunctionScope scope("singular_factors");
+  input_like(state);
+  std::vector<Symbol *> to;
+  for (int v : current().inputs)
+    to.push_back(g_prog->vars[v].sym);
+  current().outputs = with_inputs(factors.values, from, to);
+  s.probe = scope.id();
+  s.probe_texts = std::move(factors.texts);
+}
+
 // For the implicit methods, the Jacobian (D sysder) traced as a function of
 // the state too (its leaves: d f_i / d y_j at j * dim + i), as sicm run
 // compiles it; left to finite differences when it cannot be traced.
@@ -969,6 +997,7 @@ Value advance(NativeProc *self, Value *a, int n) {
   state_args(a[0], s, who);
   s.args.push_back(expr_of(a[1], who));
   trace_system(self->a, a[0], s, who);
+  trace_singular_factors(a[0], s);
   trace_jacobian(self->a, a[0], s);
   Value r = state_result(a[0], s);
   emit(std::move(s));
@@ -991,6 +1020,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   s.args.push_back(expr_of(a[2], who));
   s.args.push_back(expr_of(a[3], who));
   trace_system(self->a, a[0], s, who);
+  trace_singular_factors(a[0], s);
   trace_jacobian(self->a, a[0], s);
   Value monitor = a[1];
   if (!is_procedure(monitor)) wrong_type(monitor, 2, who);

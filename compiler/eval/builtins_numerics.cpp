@@ -528,7 +528,7 @@ const Kernel *auto_kernel(Value sysder, Value state, size_t dim) {
     if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape)) return c.kernel;
   if (g_auto_kernels >= kMaxAutoKernels) return nullptr;
   std::string why;
-  const Kernel *k = compile_kernel(sysder, list({state}), "system_derivative", &why);
+  const Kernel *k = compile_kernel(sysder, list({state}), "system_derivative", &why, true);
   if (k) ++g_auto_kernels;
   if (k && (k->nin != dim || k->nout != dim)) k = nullptr;
   if (g_compiled.size() >= kCompiledMemo) g_compiled.erase(g_compiled.begin());
@@ -560,6 +560,7 @@ struct OdeProblem {
   std::vector<double> y;
   OdeCallback cb;
   double t0; // the integrator's starting time: the state's time, or 0
+  std::vector<const char *> probe_texts; // the kernel's, for the integrator
 
   OdeProblem(SrcLoc loc, const char *who, Value sysder, Value state, int argpos)
       : cb(loc, who, sysder, &shape) {
@@ -578,6 +579,15 @@ struct OdeProblem {
   OdePtr make_integrator(const sicm_ode_step_type *T, double eps) {
     OdePtr ode(sicm_ode_alloc(T, shape.dim(), call_sysder, &cb, eps, eps));
     if (!ode) numeric_error(cb.loc, cb.who, reason_of(g_runtime_message));
+    // What the compiled derivative divides by, to name a singularity where
+    // the integration fails.
+    if (cb.kernel && cb.kernel->singular_factors) {
+      probe_texts.clear();
+      for (const std::string &text : cb.kernel->singular_texts)
+        probe_texts.push_back(text.c_str());
+      sicm_ode_set_singularity_probe(ode.get(), cb.kernel->singular_factors, nullptr,
+                                     probe_texts.size(), probe_texts.data());
+    }
     // Implicit methods solve with the Jacobian: from a kernel of (D sysder)
     // when the derivative itself compiled, else by finite differences.
     if ((T == sicm_ode_step_msbdf || T == sicm_ode_step_cvode_bdf) && cb.kernel) {

@@ -25,6 +25,24 @@ int sicm_ode_finite(size_t n, const double *v) {
   return 1;
 }
 
+/* The singularity probe's buffers (see sicm_ode_set_singularity_probe). */
+static double *probe_y_start(sicm_ode *o) {
+  return o->probe_work;
+}
+static double *probe_y_bad(sicm_ode *o) {
+  return o->probe_work + o->dim;
+}
+static double *probe_values(sicm_ode *o) {
+  return o->probe_work + 2 * o->dim;
+}
+
+static void remember_bad_state(sicm_ode *o, double t, const double *y) {
+  if (!o->probe) return;
+  memcpy(probe_y_bad(o), y, o->dim * sizeof *y);
+  o->t_bad = t;
+  o->have_bad = 1;
+}
+
 int sicm_ode_call_rhs(sicm_ode *o, double t, const double *y, double *dydt) {
   /* A trial state can be non-finite when a step was far too long; refusing
    * it (instead of calling the user's code with NaNs) lets the backend
@@ -37,6 +55,7 @@ int sicm_ode_call_rhs(sicm_ode *o, double t, const double *y, double *dydt) {
     return SICM_EUSER;
   }
   if (sicm_ode_finite(o->dim, dydt)) return SICM_SUCCESS;
+  remember_bad_state(o, t, y);
   /* A singular matrix is a property of the state, not of the step: no
    * shorter step would help, so it stops the integration like a user
    * function's refusal (sicm_ode_fail_user names it). */
@@ -154,6 +173,46 @@ static void format_state(char *buf, size_t size, size_t n, const double *y) {
   if (len + 1 < size) snprintf(buf + len, size - len, "]");
 }
 
+/* A shrink by this factor, from where the evolve call began, marks the
+ * quantity that went to zero: far below the variation of a regular motion
+ * over one call, far above the shrink a collision or a coordinate
+ * singularity shows at a failed step (1e-8 and less in the tests). */
+static const double kSingularShrink = 1e-3;
+
+/* Appends to the message the probe's quantity that has gone to zero at the
+ * failure, if one has. */
+static void name_singularity(sicm_ode *o, double t, const double *y) {
+  if (!o->probe || o->probe_count == 0) return;
+  const size_t n = o->probe_count;
+  double *at_start = probe_values(o), *there = at_start + n;
+  const double *where = o->have_bad ? probe_y_bad(o) : y;
+  const double t_where = o->have_bad ? o->t_bad : t;
+  o->probe(probe_y_start(o), at_start, o->probe_params);
+  o->probe(where, there, o->probe_params);
+  size_t best = n;
+  double best_shrink = kSingularShrink;
+  for (size_t k = 0; k < n; k++) {
+    double shrink = fabs(there[k]) / fabs(at_start[k]);
+    if (at_start[k] != 0 && isfinite(at_start[k]) && isfinite(there[k]) && shrink <= best_shrink) {
+      best = k;
+      best_shrink = shrink;
+    }
+  }
+  if (best == n) return;
+  char was[SICM_DOUBLE_BUFSIZE], is[SICM_DOUBLE_BUFSIZE], t0[SICM_DOUBLE_BUFSIZE],
+      t1[SICM_DOUBLE_BUFSIZE];
+  sicm_format_double(was, at_start[best]);
+  sicm_format_double(is, there[best]);
+  sicm_format_double(t0, o->t_start);
+  sicm_format_double(t1, t_where);
+  size_t len = strlen(o->message);
+  snprintf(o->message + len, sizeof o->message - len,
+           "; the system derivative divides by %.200s, which went from %s at t = %s to %s at "
+           "t = %s: its equations are singular there (a collision, or coordinates that are "
+           "singular at that state)",
+           o->probe_texts[best], was, t0, is, t1);
+}
+
 int sicm_ode_fail(sicm_ode *o, int status, double t, const double *y, const char *what,
                   const char *detail) {
   char tbuf[SICM_DOUBLE_BUFSIZE];
@@ -174,6 +233,8 @@ int sicm_ode_fail(sicm_ode *o, int status, double t, const double *y, const char
              " (component %ld of the derivative, counting the time's as 0, was %s)",
              o->bad_component, vbuf);
   }
+  if (status == SICM_ESTEP || status == SICM_EBADFUNC || status == SICM_ESINGULAR)
+    name_singularity(o, t, y);
   return sicm_error(status, "%s", o->message);
 }
 
@@ -413,6 +474,7 @@ void sicm_ode_free(sicm_ode *o) {
   if (o->backend) o->type->free(o);
   free(o->y_last);
   free(o->stiffness_work);
+  free(o->probe_work);
   free(o);
 }
 
@@ -481,6 +543,11 @@ int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y) {
                          "the initial state has NaN or infinite components");
   if (*t == t1) return SICM_SUCCESS;
   o->bad_component = -1;
+  if (o->probe) {
+    memcpy(probe_y_start(o), y, o->dim * sizeof *y);
+    o->t_start = *t;
+    o->have_bad = 0;
+  }
   /* Restart the method if the caller moved the state or reversed direction:
    * multistep history and the step size belong to the old trajectory. */
   if ((o->have_last && (*t != o->t_last || memcmp(y, o->y_last, o->dim * sizeof *y) != 0)) ||
@@ -502,6 +569,23 @@ int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y) {
   o->have_last = 1;
   o->t_last = t1;
   memcpy(o->y_last, y, o->dim * sizeof *y);
+  return SICM_SUCCESS;
+}
+
+int sicm_ode_set_singularity_probe(sicm_ode *o, sicm_ode_probe probe, const double *params,
+                                   size_t n, const char *const *texts) {
+  free(o->probe_work);
+  o->probe = NULL;
+  o->probe_work = NULL;
+  if (!probe || n == 0 || !texts) return SICM_SUCCESS;
+  o->probe_work = malloc((2 * o->dim + 2 * n) * sizeof *o->probe_work);
+  if (!o->probe_work)
+    return sicm_error(SICM_ENOMEM, "sicm_ode_set_singularity_probe (%s): out of memory",
+                      o->type->name);
+  o->probe = probe;
+  o->probe_params = params;
+  o->probe_count = n;
+  o->probe_texts = texts;
   return SICM_SUCCESS;
 }
 

@@ -63,6 +63,18 @@ struct sicm_ode {
    * many checks in a row found the step held by stability, and its scratch
    * (NULL until the first check), which begins with the power iteration's
    * vector (have_vector: valid). */
+  /* sicm_ode_set_singularity_probe: what the system derivative divides by,
+   * evaluated where an integration fails (NULL: no probe). y_start is the
+   * state the current evolve call began at; y_bad the last state at which
+   * the derivative was non-finite or met a singular matrix (have_bad). */
+  sicm_ode_probe probe;
+  const double *probe_params;
+  size_t probe_count;
+  const char *const *probe_texts;
+  double *probe_work; /* y_start, y_bad (dim each), values at both (probe_count each) */
+  double t_start, t_bad;
+  int have_bad;
+
   int horizon_set; /* sicm_ode_set_horizon: where the caller is going */
   double horizon;
   unsigned long steps_since_check;

@@ -364,6 +364,9 @@ static void open_integrator(const sicm_site *site, const char *who, const sicm_d
   it->jac_out = NULL;
   it->o = sicm_ode_alloc(ode->method, ode->dim, rhs_of_integrator, it, ode->tol, ode->tol);
   if (!it->o) fail_with_status(site, who);
+  if (ode->probe.fn && sicm_ode_set_singularity_probe(it->o, ode->probe.fn, ode->probe.p,
+                                                      ode->probe_count, ode->probe_texts))
+    fail_with_status(site, who);
   if (it->jacobian.fn) {
     it->jac_out = malloc(ode->dim * ode->dim * sizeof *it->jac_out);
     if (!it->jac_out) sicm_program_fail(site, who, "out of memory");

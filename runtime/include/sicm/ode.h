@@ -178,6 +178,21 @@ int sicm_ode_set_max_steps(sicm_ode *o, unsigned long max_steps);
  * The same message goes to the error hook. */
 int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y);
 
+/* sicm_ode_set_singularity_probe names the cause when an integration
+ * fails at a singularity of its equations (a collision, coordinates that
+ * are singular there). probe(y, values, params) computes n quantities the
+ * system derivative divides by, at the state y; texts[k] says what
+ * values[k] is, e.g. "(sin (ref state 1 0))" (the compiler makes both from
+ * the derivative's code). When a step fails (step size too small, a
+ * non-finite derivative, a singular matrix), the message names the
+ * quantity that has shrunk most, relative to its value where the evolve
+ * call began, if it has shrunk by a factor of a thousand or more: at the
+ * last state where the derivative failed, or else at the state reported.
+ * params and texts must outlive o. Returns SICM_ENOMEM or SICM_SUCCESS. */
+typedef void (*sicm_ode_probe)(const double *y, double *values, const double *params);
+int sicm_ode_set_singularity_probe(sicm_ode *o, sicm_ode_probe probe, const double *params,
+                                   size_t n, const char *const *texts);
+
 /* sicm_ode_set_horizon tells the integrator that the caller will go on
  * calling sicm_ode_evolve towards t_end (a loop that stops every dt to
  * monitor the state): the stiffness watch then judges the work left to

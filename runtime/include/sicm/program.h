@@ -126,6 +126,12 @@ typedef struct {
   /* For implicit methods, a kernel of (D sysder): d f_i / d y_j at
    * out[j * dim + i]; NULL fn for finite differences. */
   sicm_closure jacobian;
+  /* What sysder divides by: a kernel of the state computing probe_count
+   * values, probe_texts[k] saying what value k is ("(sin (ref state 1 0))");
+   * NULL fn for none. See sicm_ode_set_singularity_probe. */
+  sicm_closure probe;
+  size_t probe_count;
+  const char *const *probe_texts;
 } sicm_drive_ode;
 
 /* ((state-advancer ...) state dt tol): y (dim leaves) becomes the state dt
