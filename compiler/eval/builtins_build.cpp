@@ -2432,7 +2432,15 @@ struct StaticWatch {
   Closure *closure;
   uint64_t calls = 0;     // calls of the closure with known arguments while watched
   uint64_t work_mark = 0; // g_work when the current window of calls began
+  int branch_depth = 0;   // g_branch_depth when the watch began
 };
+
+// A watched loop whose known calls nest this deep under tests on run-time
+// values is left for run time at once: each iteration's test is one more
+// level of alternatives, so unrolling it would end at kMaxBranchDepth (a
+// Poincare-section refinement that halves its step 50 times, keeping its
+// known state in the branch that halves and a run-time one in the other).
+constexpr int kMaxWatchedBranchDepth = kMaxBranchDepth / 2;
 struct UnrollLimit { // thrown to the watched call of `closure`
   Closure *closure;
 };
@@ -2445,6 +2453,7 @@ bool count_known_call(Closure *c) {
   for (auto w = g_watches.rbegin(); w != g_watches.rend(); ++w) {
     StaticWatch &watch = **w;
     if (watch.closure != c) continue;
+    if (g_branch_depth - watch.branch_depth >= kMaxWatchedBranchDepth) throw UnrollLimit{c};
     uint64_t limit = current_limits().max_unrolled_iterations;
     uint64_t window = std::max<uint64_t>(1, limit / 2);
     if (++watch.calls % window == 0) {
@@ -2460,7 +2469,7 @@ bool watch_known_call(Value f, Value *slots, long n, Value *out) {
   Closure *c = f.as<Closure>();
   if (current_limits().max_unrolled_iterations == kUnlimited || g_unrolled_lambdas.count(c->lambda))
     return false;
-  StaticWatch watch{c, 0, g_work};
+  StaticWatch watch{c, 0, g_work, g_branch_depth};
   std::vector<RStmt> block;
   Value v;
   gcvec<Assignment> assigned;
