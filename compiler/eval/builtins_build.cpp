@@ -337,8 +337,13 @@ Value with_retrace(const std::function<Value()> &body) {
   size_t depth = g_open.size();
   if (depth != 1) return body(); // the outermost primitive retraces
   size_t nfunctions = g_prog->functions.size(), nvars = g_prog->vars.size();
+  // The primitive's call site: tracing its procedures moves the evaluator's
+  // idea of the current call into them, and a retrace must not take that
+  // for the primitive's place (its errors and sites name the call).
+  const SrcLoc call = current_call_loc();
   for (;;) {
     size_t nbody = current().body.size();
+    reset_call_loc(call);
     try {
       return body();
     } catch (const Retrace &) {

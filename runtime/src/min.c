@@ -13,8 +13,7 @@
 enum { kBrentMaxIter = 1000, kGridPoints = 64, kStallLimit = 4 };
 
 static int bad_value1(const char *who, const fn1 *w) {
-  return sicm_error(SICM_EBADFUNC, "%s: the function is not finite at x = %.17g (value %g)", who,
-                    w->bad_x, w->bad_value);
+  return fn1_nonfinite(who, w);
 }
 
 /* Find an interior point m of [a, b] with f(m) below f at the ends of a

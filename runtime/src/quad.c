@@ -11,8 +11,7 @@
 enum { kMaxIntervals = 1000, kRombergLevels = 20 };
 
 static int bad_value(const char *who, const fn1 *w) {
-  return sicm_error(SICM_EBADFUNC, "%s: the integrand is not finite at x = %.17g (value %g)", who,
-                    w->bad_x, w->bad_value);
+  return fn1_nonfinite(who, w);
 }
 
 /* Why GSL's adaptive routines stopped short, in words. */

@@ -20,8 +20,7 @@ int sicm_root_brent(double (*f)(double, void *), void *params, double a, double 
   fn1 w = {f, params, 0, 0, 0};
   double fa = call1(a, &w), fb = call1(b, &w);
   if (w.bad)
-    return sicm_error(SICM_EBADFUNC, "%s: the function is not finite at x = %.17g (value %g)", who,
-                      w.bad_x, w.bad_value);
+    return fn1_nonfinite(who, &w);
   if (fa == 0 || fb == 0) {
     *root = fa == 0 ? a : b;
     return SICM_SUCCESS;
@@ -53,8 +52,7 @@ int sicm_root_brent(double (*f)(double, void *), void *params, double a, double 
   gsl_root_fsolver_free(s);
   gsl_set_error_handler(old);
   if (w.bad)
-    return sicm_error(SICM_EBADFUNC, "%s: the function is not finite at x = %.17g (value %g)", who,
-                      w.bad_x, w.bad_value);
+    return fn1_nonfinite(who, &w);
   if (gs == GSL_EMAXITER)
     return sicm_error(SICM_EMAXITER, "%s: no convergence in %d iterations; best estimate %.17g",
                       who, kMaxIter, *root);

@@ -6,6 +6,8 @@
 
 #include <math.h>
 
+#include "sicm/runtime.h"
+
 typedef struct {
   double (*f)(double, void *);
   void *params;
@@ -23,6 +25,17 @@ static inline double call1(double x, void *data) {
     w->bad_value = v;
   }
   return v;
+}
+
+/* Report the first non-finite value in the words sicm run uses (numbers
+ * as the compiler prints them: "the function is +inf.0 at .1, not a finite
+ * number"), so that a built program says what the interpreter says. */
+static inline int fn1_nonfinite(const char *who, const fn1 *w) {
+  char value[SICM_DOUBLE_BUFSIZE], at[SICM_DOUBLE_BUFSIZE];
+  sicm_format_double(value, w->bad_value);
+  sicm_format_double(at, w->bad_x);
+  return sicm_error(SICM_EBADFUNC, "%s: the function is %s at %s, not a finite number", who, value,
+                    at);
 }
 
 #endif /* SICM_WATCHED_FN_H */
