@@ -21,6 +21,7 @@
 #include "eval/plot.hpp"
 #include "eval/procedure.hpp"
 #include "repl/repl.hpp"
+#include "sicm/runtime.h"
 #include "syntax/error.hpp"
 
 namespace {
@@ -52,10 +53,12 @@ constexpr size_t kMaxEvalStackBytes = SIZE_MAX;
 #endif
 
 const char kUsage[] =
-    "usage: sicm run FILE [--plot-dir DIR] [--param NAME=VALUE ...]\n"
+    "usage: sicm run FILE [--plot-dir DIR] [--param NAME=VALUE ...] [--stats]\n"
     "                            evaluate a program, printing each top-level value;\n"
     "                            plots (frame ...) are written to DIR (default .);\n"
-    "                            --param sets (parameter 'NAME default)\n"
+    "                            --param sets (parameter 'NAME default); --stats\n"
+    "                            prints what each integration cost on stderr (so\n"
+    "                            do built programs given --stats)\n"
     "       sicm build FILE [-o EXE] [-O0|-O1|-O2|-O3] [--keep-c]\n"
     "                            compile to an executable (default: FILE without\n"
     "                            .sicm); --keep-c leaves the C as EXE.c\n"
@@ -198,6 +201,8 @@ int dispatch(const std::vector<std::string> &args) {
       std::string why;
       if (args[i] == "--plot-dir" && i + 1 < args.size()) {
         sicm::set_plot_directory(args[++i]);
+      } else if (args[i] == "--stats") {
+        sicm_stats_enable();
       } else if (args[i] == "--param" && i + 1 < args.size()) {
         if (!sicm::set_parameter_option(args[++i], &why)) {
           std::fprintf(stderr, "sicm: %s\n", why.c_str());
@@ -274,5 +279,6 @@ int main(int argc, char **argv) {
     return 1;
   }
   pthread_join(thread, nullptr);
+  sicm_stats_print(stderr); // --stats: after the run, whether it succeeded or failed
   return job.status;
 }

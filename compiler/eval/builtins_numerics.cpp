@@ -429,8 +429,22 @@ int call_jacobian(double, const double *y, double *dfdy, double *dfdt, void *dat
   return 0;
 }
 
+// Frees an integrator, first adding what it cost to --stats (sicm/stats.h):
+// its call site, primitive and tolerance, and the seconds counted in *seconds.
 struct OdeDeleter {
-  void operator()(sicm_ode *o) const { sicm_ode_free(o); }
+  SrcLoc loc;
+  const char *who = "";
+  double tolerance = 0;
+  const double *seconds = nullptr;
+  void operator()(sicm_ode *o) const {
+    if (sicm_stats_enabled() && seconds) {
+      std::string where =
+          source_name(loc.file) + ":" + std::to_string(loc.line) + ":" + std::to_string(loc.col);
+      sicm_stats_add(where.c_str(), who, sicm_ode_name(o), tolerance, sicm_ode_get_stats(o),
+                     *seconds);
+    }
+    sicm_ode_free(o);
+  }
 };
 using OdePtr = std::unique_ptr<sicm_ode, OdeDeleter>;
 
@@ -559,8 +573,9 @@ struct OdeProblem {
   StateShape shape;
   std::vector<double> y;
   OdeCallback cb;
-  double t0; // the integrator's starting time: the state's time, or 0
+  double t0;                             // the integrator's starting time: the state's time, or 0
   std::vector<const char *> probe_texts; // the kernel's, for the integrator
+  double seconds = 0;                    // spent integrating, for --stats
 
   OdeProblem(SrcLoc loc, const char *who, Value sysder, Value state, int argpos)
       : cb(loc, who, sysder, &shape) {
@@ -577,7 +592,8 @@ struct OdeProblem {
   }
 
   OdePtr make_integrator(const sicm_ode_step_type *T, double eps) {
-    OdePtr ode(sicm_ode_alloc(T, shape.dim(), call_sysder, &cb, eps, eps));
+    OdePtr ode(sicm_ode_alloc(T, shape.dim(), call_sysder, &cb, eps, eps),
+               OdeDeleter{cb.loc, cb.who, eps, &seconds});
     if (!ode) numeric_error(cb.loc, cb.who, reason_of(g_runtime_message));
     // What the compiled derivative divides by, to name a singularity where
     // the integration fails.
@@ -599,7 +615,10 @@ struct OdeProblem {
 
   // Advance the integrator to t1; errors at the call site on failure.
   void evolve_to(sicm_ode *ode, double &t, double t1) {
+    const bool timed = sicm_stats_enabled(); // the clock only for --stats
+    const double start = timed ? sicm_stats_clock() : 0;
     int status = sicm_ode_evolve(ode, &t, t1, y.data());
+    if (timed) seconds += sicm_stats_clock() - start;
     cb.rethrow_if_failed();
     if (status != SICM_SUCCESS) numeric_error(cb.loc, cb.who, sicm_ode_last_error(ode));
   }

@@ -41,7 +41,7 @@ static double param_values[kMaxParams];
 static int nparams;
 
 static void usage(FILE *f, const char *argv0, const char *const *parameters) {
-  fprintf(f, "usage: %s [--plot-dir DIR]", argv0);
+  fprintf(f, "usage: %s [--plot-dir DIR] [--stats]", argv0);
   for (const char *const *p = parameters; *p; ++p)
     fprintf(f, " [--param %s=VALUE]", *p);
   fputc('\n', f);
@@ -64,11 +64,20 @@ static int set_param(const char *assignment, const char *const *parameters) {
   return 0;
 }
 
+/* --stats: after the run (or a failure), what each integration site cost. */
+static void print_stats(void) {
+  fflush(stdout);
+  sicm_stats_print(stderr);
+}
+
 void sicm_program_init(int argc, char **argv, const char *program_name,
                        const char *const *parameters) {
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--plot-dir") == 0 && i + 1 < argc) {
       plot_dir = argv[++i];
+    } else if (strcmp(argv[i], "--stats") == 0) {
+      if (!sicm_stats_enabled()) atexit(print_stats);
+      sicm_stats_enable();
     } else if (strcmp(argv[i], "--param") == 0 && i + 1 < argc) {
       if (!set_param(argv[++i], parameters)) {
         fprintf(stderr, "%s: --param %s: not NAME=NUMBER for a parameter of the program\n", argv[0],
@@ -78,7 +87,8 @@ void sicm_program_init(int argc, char **argv, const char *program_name,
       }
     } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
       usage(stdout, argv[0], parameters);
-      printf("  a program compiled by sicm build from %s; plots go to DIR (default .)\n",
+      printf("  a program compiled by sicm build from %s; plots go to DIR (default .);\n"
+             "  --stats prints what each integration cost on stderr after the run\n",
              program_name);
       exit(0);
     } else {
@@ -332,6 +342,11 @@ typedef struct {
   sicm_closure jacobian;
   size_t dim;
   double *jac_out; /* dim * dim, the kernel's column-major Jacobian */
+  /* For --stats: the call's site and primitive, its tolerance, and the
+   * seconds spent in the integrator (monitors not counted). */
+  const sicm_site *site;
+  const char *who;
+  double tol, seconds;
 } integrator;
 
 /* The runtime's Jacobian callback from a kernel of (D sysder) (see
@@ -362,6 +377,10 @@ static void open_integrator(const sicm_site *site, const char *who, const sicm_d
   it->jacobian = ode->jacobian;
   it->dim = ode->dim;
   it->jac_out = NULL;
+  it->site = site;
+  it->who = who;
+  it->tol = ode->tol;
+  it->seconds = 0;
   it->o = sicm_ode_alloc(ode->method, ode->dim, rhs_of_integrator, it, ode->tol, ode->tol);
   if (!it->o) fail_with_status(site, who);
   if (ode->probe.fn && sicm_ode_set_singularity_probe(it->o, ode->probe.fn, ode->probe.p,
@@ -375,13 +394,19 @@ static void open_integrator(const sicm_site *site, const char *who, const sicm_d
 }
 
 static void close_integrator(integrator *it) {
+  sicm_stats_add(it->site->where, it->who, sicm_ode_name(it->o), it->tol, sicm_ode_get_stats(it->o),
+                 it->seconds);
   sicm_ode_free(it->o);
   free(it->jac_out);
 }
 
 static void evolve_to(const sicm_site *site, const char *who, integrator *it, double *t, double t1,
                       double *y) {
-  if (sicm_ode_evolve(it->o, t, t1, y) != SICM_SUCCESS) {
+  const int timed = sicm_stats_enabled(); /* the clock only for --stats */
+  const double start = timed ? sicm_stats_clock() : 0;
+  const int status = sicm_ode_evolve(it->o, t, t1, y);
+  if (timed) it->seconds += sicm_stats_clock() - start;
+  if (status != SICM_SUCCESS) {
     snprintf(last_reason, sizeof last_reason, "%s", sicm_ode_last_error(it->o));
     close_integrator(it);
     fail_with_status(site, who);

@@ -18,6 +18,7 @@
 #include "sicm/quad.h"
 #include "sicm/program.h"
 #include "sicm/root.h"
+#include "sicm/stats.h"
 
 #ifdef __cplusplus
 extern "C" {

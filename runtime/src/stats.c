@@ -1,0 +1,88 @@
+/* Per-site integration statistics for --stats (see sicm/stats.h). */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, strdup */
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "sicm/runtime.h"
+
+typedef struct {
+  char *where, *who, *method;
+  double tolerance;
+  unsigned long calls;
+  sicm_ode_stats work;
+  double seconds;
+} site_line;
+
+static int enabled;
+static site_line *lines;
+static size_t nlines, capacity;
+
+void sicm_stats_enable(void) {
+  enabled = 1;
+}
+
+int sicm_stats_enabled(void) {
+  return enabled;
+}
+
+double sicm_stats_clock(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static site_line *line_of(const char *where, const char *who, const char *method,
+                          double tolerance) {
+  for (size_t i = 0; i < nlines; i++)
+    if (strcmp(lines[i].where, where) == 0 && strcmp(lines[i].who, who) == 0 &&
+        strcmp(lines[i].method, method) == 0 && lines[i].tolerance == tolerance)
+      return &lines[i];
+  if (nlines == capacity) {
+    size_t more = capacity ? 2 * capacity : 16;
+    site_line *grown = realloc(lines, more * sizeof *grown);
+    if (!grown) return NULL;
+    lines = grown;
+    capacity = more;
+  }
+  site_line *l = &lines[nlines];
+  *l = (site_line){strdup(where), strdup(who), strdup(method), tolerance, 0, {0, 0, 0, 0}, 0};
+  if (!l->where || !l->who || !l->method) {
+    free(l->where), free(l->who), free(l->method);
+    return NULL;
+  }
+  nlines++;
+  return l;
+}
+
+void sicm_stats_add(const char *where, const char *who, const char *method, double tolerance,
+                    const sicm_ode_stats *work, double seconds) {
+  if (!enabled) return;
+  site_line *l = line_of(where ? where : "?", who ? who : "?", method ? method : "?", tolerance);
+  if (!l) return; /* out of memory: the statistics are a convenience */
+  l->calls++;
+  l->work.steps += work->steps;
+  l->work.rejected_steps += work->rejected_steps;
+  l->work.rhs_evals += work->rhs_evals;
+  l->work.jacobian_evals += work->jacobian_evals;
+  l->seconds += seconds;
+}
+
+void sicm_stats_print(FILE *f) {
+  if (nlines == 0) return;
+  fputs("integration statistics (--stats), one line per site, method and tolerance:\n", f);
+  for (size_t i = 0; i < nlines; i++) {
+    const site_line *l = &lines[i];
+    char tol[SICM_DOUBLE_BUFSIZE], secs[SICM_DOUBLE_BUFSIZE];
+    sicm_format_double(tol, l->tolerance);
+    /* Seconds to 3 significant digits: the clock is not more repeatable. */
+    char rounded[32];
+    snprintf(rounded, sizeof rounded, "%.3g", l->seconds);
+    sicm_format_double(secs, strtod(rounded, NULL));
+    fprintf(f,
+            "%s: %s, %s, tolerance %s: %lu call%s, %lu steps (%lu rejected), %lu rhs "
+            "evaluations, %s s\n",
+            l->where, l->who, l->method, tol, l->calls, l->calls == 1 ? "" : "s", l->work.steps,
+            l->work.rejected_steps, l->work.rhs_evals, secs);
+  }
+}

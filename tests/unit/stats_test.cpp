@@ -1,0 +1,44 @@
+// Unit tests of the per-site integration statistics of --stats (runtime/src/stats.c).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "sicm/runtime.h"
+
+namespace {
+
+std::string printed() {
+  char *text = nullptr;
+  size_t size = 0;
+  FILE *f = open_memstream(&text, &size);
+  sicm_stats_print(f);
+  std::fclose(f);
+  std::string s(text, size);
+  std::free(text);
+  return s;
+}
+
+// One process holds one record, so the cases run in order in one test.
+TEST(Stats, OneLinePerSiteMethodAndTolerance) {
+  const sicm_ode_stats a = {100, 5, 1300, 0}, b = {40, 1, 500, 0};
+  sicm_stats_add("x.sicm:3:1", "evolve", "rk8pd", 1e-10, &a, 0.5);
+  EXPECT_EQ(printed(), "") << "nothing is recorded before --stats";
+
+  sicm_stats_enable();
+  sicm_stats_add("x.sicm:3:1", "evolve", "rk8pd", 1e-10, &a, 0.5);
+  sicm_stats_add("x.sicm:3:1", "evolve", "rk8pd", 1e-10, &b, 0.25);
+  sicm_stats_add("x.sicm:3:1", "evolve", "bulirsch-stoer", 1e-10, &b, 0.125);
+  sicm_stats_add("x.sicm:9:5", "state-advancer", "rk8pd", 1e-10, &b, 0.001);
+  EXPECT_EQ(printed(),
+            "integration statistics (--stats), one line per site, method and tolerance:\n"
+            "x.sicm:3:1: evolve, rk8pd, tolerance .0000000001: 2 calls, 140 steps (6 rejected), 1800 rhs "
+            "evaluations, .75 s\n"
+            "x.sicm:3:1: evolve, bulirsch-stoer, tolerance .0000000001: 1 call, 40 steps (1 rejected), 500 "
+            "rhs evaluations, .125 s\n"
+            "x.sicm:9:5: state-advancer, rk8pd, tolerance .0000000001: 1 call, 40 steps (1 rejected), 500 "
+            "rhs evaluations, .001 s\n");
+}
+
+} // namespace
