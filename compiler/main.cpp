@@ -12,11 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "bench/integration_sites.hpp"
+#include "bench/work_precision.hpp"
 #include "codegen/build_exe.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
 #include "eval/limits.hpp"
+#include "eval/numerics_defaults.hpp"
 #include "eval/parameter.hpp"
 #include "eval/plot.hpp"
 #include "eval/procedure.hpp"
@@ -66,6 +69,12 @@ const char kUsage[] =
     "       sicm emit-kernels FILE\n"
     "                            run the program quietly and print the C of every\n"
     "                            kernel sicm run compiles (state derivatives, ...)\n"
+    "       sicm bench FILE [--out DIR] [--methods M1,M2,...] [--tolerances FROM:TO]\n"
+    "                  [--repeats N]\n"
+    "                            run the program quietly, then each integration it\n"
+    "                            performs (first call per site) with every method and\n"
+    "                            tolerance: DIR/work-precision.tsv and .svg (default\n"
+    "                            DIR: FILE-bench; tolerances 1e-3:1e-14 by decades)\n"
     "       sicm repl            interactive read-eval-print loop\n"
     "       sicm --version\n"
     "run, build, emit-c, emit-kernels and repl also take the limit flags\n"
@@ -103,8 +112,9 @@ void collect_kernel(const sicm::Kernel *k) {
   g_emitted += "/* ---- kernel " + k->c_name + " ---- */\n" + k->c_source + "\n";
 }
 
-int emit_c(const std::string &path) {
-  sicm::set_kernel_listener(collect_kernel);
+// Run a program with its output discarded and its plots in a scratch
+// directory, removed afterwards (sicm emit-kernels, sicm bench).
+int run_quietly(const std::string &path) {
   // Plots go to a scratch directory, removed afterwards.
   const char *tmp = std::getenv("TMPDIR");
   std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/sicm-emit-XXXXXX";
@@ -134,6 +144,76 @@ int emit_c(const std::string &path) {
   sicm::flush_output();
   if (saved >= 0) dup2(saved, 1);
   if (null_fd >= 0) close(null_fd);
+  return status;
+}
+
+// sicm bench FILE [--out DIR] [--methods M1,M2,...] [--tolerances FROM:TO] [--repeats N]
+int bench(const std::vector<std::string> &args) {
+  sicm::BenchOptions o;
+  std::string file;
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string &a = args[i];
+    bool has_value = i + 1 < args.size();
+    if (a == "--out" && has_value) {
+      o.out_dir = args[++i];
+    } else if (a == "--methods" && has_value) {
+      std::stringstream list(args[++i]);
+      for (std::string m; std::getline(list, m, ',');) {
+        if (!sicm::integrator_named(m)) {
+          std::fprintf(stderr, "sicm bench: --methods: no integrator is named %s\n", m.c_str());
+          return kExitUsage;
+        }
+        o.methods.push_back(m);
+      }
+    } else if (a == "--tolerances" && has_value) {
+      const std::string &range = args[++i];
+      size_t colon = range.find(':');
+      char *end1 = nullptr, *end2 = nullptr;
+      double from = colon == std::string::npos ? 0 : std::strtod(range.c_str(), &end1);
+      double to = colon == std::string::npos ? 0 : std::strtod(range.c_str() + colon + 1, &end2);
+      if (colon == std::string::npos || end1 != range.c_str() + colon || *end2 != '\0' ||
+          !(from > 0) || !(to > 0) || to > from) {
+        std::fprintf(stderr, "sicm bench: --tolerances %s: want FROM:TO, FROM >= TO > 0\n",
+                     range.c_str());
+        return kExitUsage;
+      }
+      o.tolerance_from = from, o.tolerance_to = to;
+    } else if (a == "--repeats" && has_value) {
+      char *end = nullptr;
+      long n = std::strtol(args[++i].c_str(), &end, 10);
+      if (*end != '\0' || n < 1 || n > 1000) {
+        std::fprintf(stderr, "sicm bench: --repeats %s: want a count from 1 to 1000\n",
+                     args[i].c_str());
+        return kExitUsage;
+      }
+      o.repeats = static_cast<int>(n);
+    } else if (file.empty() && a.rfind("--", 0) != 0) {
+      file = a;
+    } else {
+      std::fputs(kUsage, stderr);
+      return kExitUsage;
+    }
+  }
+  if (file.empty()) {
+    std::fputs(kUsage, stderr);
+    return kExitUsage;
+  }
+  if (o.out_dir.empty()) {
+    o.out_dir = file;
+    if (o.out_dir.size() > 5 && o.out_dir.compare(o.out_dir.size() - 5, 5, ".sicm") == 0)
+      o.out_dir.resize(o.out_dir.size() - 5);
+    o.out_dir += "-bench";
+  }
+  sicm::record_integration_sites(true);
+  int status = run_quietly(file);
+  sicm::record_integration_sites(false);
+  if (status != 0) return status;
+  return sicm::run_work_precision(o);
+}
+
+int emit_c(const std::string &path) {
+  sicm::set_kernel_listener(collect_kernel);
+  int status = run_quietly(path);
   if (status == 0) {
     if (g_emitted.empty()) std::fputs("/* this program compiles no kernels */\n", stdout);
     std::fputs(g_emitted.c_str(), stdout);
@@ -157,6 +237,7 @@ int dispatch(const std::vector<std::string> &args) {
     std::fputs(("\n" + sicm::limits_usage()).c_str(), stdout);
     return 0;
   }
+  if (cmd == "bench") return bench(args);
   if (cmd == "emit-kernels") {
     if (args.size() != 2) {
       std::fputs(kUsage, stderr);

@@ -42,6 +42,7 @@
 
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
+#include "bench/integration_sites.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/number.hpp"
 #include "eval/numerics_defaults.hpp"
@@ -613,6 +614,16 @@ struct OdeProblem {
     return ode;
   }
 
+  // For sicm bench: this integration, from the current state over [t0, t1].
+  void record_site(const char *who, double t1, double eps, const sicm_ode_step_type *T) {
+    if (!recording_integration_sites()) return;
+    record_integration_site(IntegrationSite{
+        source_name(cb.loc.file) + ":" + std::to_string(cb.loc.line) + ":" +
+            std::to_string(cb.loc.col),
+        who, cb.kernel ? cb.kernel->fn : nullptr, y, shape.time_first(), t0, t1, eps,
+        sicm_ode_step_type_name(T)});
+  }
+
   // Advance the integrator to t1; errors at the call site on failure.
   void evolve_to(sicm_ode *ode, double &t, double t1) {
     const bool timed = sicm_stats_enabled(); // the clock only for --stats
@@ -671,6 +682,7 @@ Value advance_state(NativeProc *self, Value *a, int n) {
   const sicm_ode_step_type *T = arg_integrator(a, n, 3, who);
   OdeProblem p(loc, who, self->a, a[0], 1);
   double t = p.t0, t1 = p.t0 + dt;
+  p.record_site(who, t1, eps, T);
   {
     RuntimeErrorScope scope;
     OdePtr ode = p.make_integrator(T, eps);
@@ -731,6 +743,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   const sicm_ode_step_type *T = arg_integrator(a, n, 5, who);
   OdeProblem p(loc, who, self->a, a[0], 1);
   if (dt == 0 && t_final != p.t0) bad_range(a[2], 3, who);
+  p.record_site(who, t_final, eps, T);
   const double step = std::fabs(dt) * (t_final >= p.t0 ? 1.0 : -1.0);
   const double near_end = 1e-9 * std::fabs(step);
 
@@ -1051,6 +1064,10 @@ Value P_eigenvalues(Value *a, int) {
 const char *integrator_c_name(const std::string &name) {
   const IntegratorName *i = find_integrator(name);
   return i ? i->c_name : nullptr;
+}
+
+const sicm_ode_step_type *integrator_named(const std::string &name) {
+  return integrator_for(name);
 }
 
 void install_numerics_primitives() {

@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "sicm/ode.h"
+
 namespace sicm {
 
 // scmutils' values.
@@ -20,5 +22,8 @@ constexpr long kBisectMaxIter = 10000;
 // The runtime's step type variable (sicm/ode.h) for an integrator's name
 // ('bulirsch-stoer, 'rk8pd, ...), or null for a name that is none.
 const char *integrator_c_name(const std::string &name);
+
+// The runtime's step type for an integrator's name, or null.
+const sicm_ode_step_type *integrator_named(const std::string &name);
 
 } // namespace sicm
