@@ -6,6 +6,8 @@
 #                   scene with sicm build and run it (writes its SVG)
 #   make stability  run the hard cases of tests/stability/ at full size, built,
 #                   and write docs/stability.md
+#   make accuracy   work-precision diagrams of four scenes (sicm bench), into
+#                   docs/accuracy.md
 #   make examples   build every figure scene at full size with sicm build,
 #                   run it, and write its plot into build/figures
 #   make install    install sicm under $(PREFIX)
@@ -58,7 +60,7 @@ SICM    := $(BUILD)/sicm
 RTLIB   := $(BUILD)/libsicmrt.a
 UNITBIN := $(BUILD)/unit-tests
 
-.PHONY: all check demo examples stability install clean deps unit fuzz-smoke
+.PHONY: all check demo examples stability accuracy install clean deps unit fuzz-smoke
 all: $(SICM) $(RTLIB)
 
 $(BUILD)/%.o: %.cpp
@@ -139,6 +141,12 @@ demo: deps
 stability: deps
 	@$(MAKE) --no-print-directory all
 	@scripts/stability-report --sicm $(SICM)
+
+# What accuracy costs in time: sicm bench on four scenes, into docs/accuracy.md
+# (generated; never edit it by hand).
+accuracy: deps
+	@$(MAKE) --no-print-directory all
+	@bench/work-precision/run --sicm $(SICM)
 
 # Every figure scene at full size, built with sicm build and run, into
 # $(BUILD)/figures (scripts/run-examples without --build interprets them).
