@@ -40,6 +40,7 @@
 namespace sicm {
 
 using KernelFn = void (*)(const double *in, double *out, const double *p);
+using TaylorFn = void (*)(const double *in, int order, double *c, const double *p);
 
 // Allocated with gc_new (it holds Values); its strings are freed by a
 // finalizer when it is collected. The loaded code is never unloaded.
@@ -57,6 +58,21 @@ struct Kernel {
   // (codegen/singular_factors.hpp), one value per text; null if nothing.
   KernelFn singular_factors = nullptr;
   std::vector<std::string> singular_texts;
+  // For a system derivative compiled with `taylor`: the Taylor coefficients
+  // of its solution (codegen/emit_taylor.hpp), for sicm_ode_step_taylor;
+  // null, with the reason in taylor_why_not, when an operation has no
+  // recurrence.
+  TaylorFn taylor = nullptr;
+  std::string taylor_why_not;
+};
+
+// What compile_kernel makes besides the kernel, for a system derivative
+// (whose one argument is the state).
+struct KernelOptions {
+  // Its singular factors, named by their place in the state ((ref state 1 0)).
+  bool probe_singularities = false;
+  // The Taylor coefficient function of its solution.
+  bool taylor = false;
 };
 
 // Compile `proc` for arguments shaped like `sample_args` (a Scheme list with
@@ -67,11 +83,9 @@ struct Kernel {
 // procedure raises while it is traced are caught and become the reason.
 // The procedure runs twice: once on symbols, once at the sample arguments to
 // check the kernel, so its side effects happen then, not when the kernel runs.
-// With probe_singularities (for a system derivative, whose one argument is
-// the state), the kernel also gets its singular factors, named by their
-// place in the state ((ref state 1 0)).
+// options asks for more functions of a system derivative (see KernelOptions).
 Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not,
-                       bool probe_singularities = false);
+                       KernelOptions options = {});
 
 // Called with every kernel compile_kernel makes (sicm emit-c lists them);
 // null (the default) for none.

@@ -19,6 +19,7 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "codegen/emit_c.hpp"
+#include "codegen/emit_taylor.hpp"
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
 #include "codegen/kernel_form.hpp"
@@ -241,7 +242,7 @@ void set_kernel_listener(KernelListener listener) {
 }
 
 Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::string *why_not,
-                       bool probe_singularities) {
+                       KernelOptions options) {
   std::string ignored;
   if (!why_not) why_not = &ignored;
   std::string kname = name ? name : procedure_name(proc);
@@ -251,7 +252,7 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   std::string source = emit_kernel_unit(t, c_name, kname);
   SingularFactors factors;
   std::string probe_name = c_name + "_singular_factors";
-  if (probe_singularities && list_length(sample_args) == 1) {
+  if (options.probe_singularities && list_length(sample_args) == 1) {
     std::vector<std::string> paths = state_leaf_paths(car(sample_args), "state");
     std::unordered_map<Symbol *, std::string> names;
     for (size_t i = 0; i < t.inputs.size() && i < paths.size(); ++i)
@@ -266,10 +267,22 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
       source += emit_kernel_function(probe, probe_name, false);
     }
   }
+  std::string taylor_name = c_name + "_taylor", taylor_why_not;
+  bool has_taylor = false;
+  if (options.taylor && list_length(sample_args) != 1)
+    taylor_why_not = "it is not a system derivative (a procedure of one state)";
+  if (options.taylor && list_length(sample_args) == 1) {
+    std::string taylor = emit_taylor_function(t, taylor_name, &taylor_why_not);
+    has_taylor = !taylor.empty();
+    if (has_taylor)
+      source += "\n" + c_taylor_support() + "void " + taylor_name +
+                "(const double *in, int order, double *c, const double *p);\n\n" + taylor;
+  }
   std::string so;
   void *fn = jit_load(source, c_name, &so, why_not);
   if (!fn) return nullptr;
   void *probe_fn = factors.values.empty() ? nullptr : jit_load(source, probe_name, &so, why_not);
+  void *taylor_fn = has_taylor ? jit_load(source, taylor_name, &so, why_not) : nullptr;
   Kernel *k = gc_new<Kernel>();
   // ignore_self: a std::string member may point into the object (its short-string buffer).
   GC_register_finalizer_ignore_self(k, finalize_kernel, nullptr, nullptr, nullptr);
@@ -284,6 +297,8 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   k->so_path = so;
   k->singular_factors = reinterpret_cast<KernelFn>(probe_fn);
   if (probe_fn) k->singular_texts = std::move(factors.texts);
+  k->taylor = reinterpret_cast<TaylorFn>(taylor_fn);
+  k->taylor_why_not = std::move(taylor_why_not);
   if (!agrees_at_sample(k, proc, sample_args, why_not)) return nullptr;
   if (g_kernel_listener) g_kernel_listener(k);
   return k;

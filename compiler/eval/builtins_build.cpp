@@ -852,6 +852,11 @@ std::string method_of(Value *a, int n, int i, const char *who) {
     runtime_error(here(), std::string(who) + ": *ode-integration-method* is " + write_string(m) +
                               ", which names no integrator");
   }
+  // Its coefficient function is generated for sicm run's kernels only.
+  if (std::string_view(c) == "sicm_ode_step_taylor")
+    cannot_compile(here(), std::string(who) +
+                               ": the taylor method is not available in sicm build yet (it "
+                               "is in sicm run); choose another integrator");
   return c;
 }
 
@@ -917,11 +922,10 @@ void trace_singular_factors(Value state, RStmt &s) {
   std::unordered_map<Symbol *, std::string> names;
   for (size_t i = 0; i < from.size() && i < paths.size(); ++i)
     names[from[i]] = paths[i];
-  SingularFactors factors =
-      singular_factors(g_prog->functions[s.callee].outputs, [&](Symbol *sym) {
-        auto it = names.find(sym);
-        return it == names.end() ? std::string() : it->second;
-      });
+  SingularFactors factors = singular_factors(g_prog->functions[s.callee].outputs, [&](Symbol *sym) {
+    auto it = names.find(sym);
+    return it == names.end() ? std::string() : it->second;
+  });
   if (factors.values.empty()) return;
   FunctionScope scope("singular_factors");
   input_like(state);

@@ -476,6 +476,8 @@ const IntegratorName kIntegrators[] = {
     {"yoshida4", &sicm_ode_step_yoshida4, "sicm_ode_step_yoshida4"},
     {"yoshida6", &sicm_ode_step_yoshida6, "sicm_ode_step_yoshida6"},
     {"yoshida8", &sicm_ode_step_yoshida8, "sicm_ode_step_yoshida8"},
+    // Taylor series from coefficients generated from the compiled derivative.
+    {"taylor", &sicm_ode_step_taylor, "sicm_ode_step_taylor"},
 };
 
 const IntegratorName *find_integrator(const std::string &name) {
@@ -499,7 +501,7 @@ const sicm_ode_step_type *arg_integrator(Value *a, int n, int i, const char *who
       runtime_error(current_call_loc(),
                     std::string(who) + ": *ode-integration-method* is " + write_string(m) +
                         ", which names no integrator (bulirsch-stoer, rk8pd, rkf45, rkck, msbdf, "
-                        "cvode-adams, cvode-bdf, verlet, yoshida4, yoshida6, yoshida8)");
+                        "cvode-adams, cvode-bdf, verlet, yoshida4, yoshida6, yoshida8, taylor)");
     return T;
   }
   const sicm_ode_step_type *T = is_symbol(a[i]) ? integrator_for(symbol_name(a[i])) : nullptr;
@@ -520,6 +522,7 @@ struct CompiledSysder {
   Value sysder;
   Value state_shape;    // a sample state
   const Kernel *kernel; // null: not traceable
+  bool taylor;          // compiled with its Taylor coefficients (if it has them)
 };
 gcvec<CompiledSysder> g_compiled; // static, hence a root for the collector
 constexpr size_t kCompiledMemo = 32;
@@ -537,17 +540,22 @@ bool kernels_enabled() {
   return enabled;
 }
 
-const Kernel *auto_kernel(Value sysder, Value state, size_t dim) {
+// With taylor, the kernel also has the Taylor coefficients of the solution
+// when its operations all have recurrences (the taylor method asks for
+// them; the others do not pay for compiling them).
+const Kernel *auto_kernel(Value sysder, Value state, size_t dim, bool taylor = false) {
   if (!kernels_enabled() || !is_procedure(sysder)) return nullptr;
   for (const CompiledSysder &c : g_compiled)
-    if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape)) return c.kernel;
+    if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape) && (c.taylor || !taylor))
+      return c.kernel;
   if (g_auto_kernels >= kMaxAutoKernels) return nullptr;
   std::string why;
-  const Kernel *k = compile_kernel(sysder, list({state}), "system_derivative", &why, true);
+  KernelOptions options{.probe_singularities = true, .taylor = taylor};
+  const Kernel *k = compile_kernel(sysder, list({state}), "system_derivative", &why, options);
   if (k) ++g_auto_kernels;
   if (k && (k->nin != dim || k->nout != dim)) k = nullptr;
   if (g_compiled.size() >= kCompiledMemo) g_compiled.erase(g_compiled.begin());
-  g_compiled.push_back(CompiledSysder{sysder, state, k});
+  g_compiled.push_back(CompiledSysder{sysder, state, k, taylor});
   return k;
 }
 
@@ -578,7 +586,9 @@ struct OdeProblem {
   std::vector<const char *> probe_texts; // the kernel's, for the integrator
   double seconds = 0;                    // spent integrating, for --stats
 
-  OdeProblem(SrcLoc loc, const char *who, Value sysder, Value state, int argpos)
+  // taylor: the integration will use the taylor method, so a derivative
+  // compiled here is compiled with its Taylor coefficients.
+  OdeProblem(SrcLoc loc, const char *who, Value sysder, Value state, int argpos, bool taylor)
       : cb(loc, who, sysder, &shape) {
     if (!shape.describe(state) || shape.dim() == 0) wrong_type(state, argpos, who);
     y.resize(shape.dim());
@@ -588,7 +598,7 @@ struct OdeProblem {
         k->nin == shape.dim() && k->nout == shape.dim())
       cb.kernel = k;
     else
-      cb.kernel = auto_kernel(sysder, state, shape.dim());
+      cb.kernel = auto_kernel(sysder, state, shape.dim(), taylor);
     t0 = shape.time_first() && std::isfinite(y[0]) ? y[0] : 0.0;
   }
 
@@ -605,6 +615,7 @@ struct OdeProblem {
       sicm_ode_set_singularity_probe(ode.get(), cb.kernel->singular_factors, nullptr,
                                      probe_texts.size(), probe_texts.data());
     }
+    if (T == sicm_ode_step_taylor) use_taylor(ode.get());
     // Implicit methods solve with the Jacobian: from a kernel of (D sysder)
     // when the derivative itself compiled, else by finite differences.
     if ((T == sicm_ode_step_msbdf || T == sicm_ode_step_cvode_bdf) && cb.kernel) {
@@ -614,14 +625,37 @@ struct OdeProblem {
     return ode;
   }
 
+  // The taylor method takes its coefficients from the compiled derivative,
+  // compiled again with them if it was compiled without; errors at the
+  // call site when there are none.
+  void use_taylor(sicm_ode *ode) {
+    if (cb.kernel && !cb.kernel->taylor) {
+      const Kernel *k = auto_kernel(cb.sysder, shape.build(y.data()), shape.dim(), true);
+      if (k) cb.kernel = k;
+    }
+    if (cb.kernel && cb.kernel->taylor) {
+      sicm_ode_set_taylor(ode, cb.kernel->taylor, nullptr);
+      return;
+    }
+    std::string why =
+        !cb.kernel ? "this one is interpreted, not compiled (it cannot be traced, SICM_INTERPRET "
+                     "is set, or too many system derivatives were compiled)"
+        : cb.kernel->taylor_why_not.empty() ? "this one was compiled without them"
+                                            : "this one has " + cb.kernel->taylor_why_not;
+    numeric_error(cb.loc, cb.who,
+                  "taylor needs a compiled system derivative whose operations all have Taylor "
+                  "recurrences; " +
+                      why);
+  }
+
   // For sicm bench: this integration, from the current state over [t0, t1].
   void record_site(const char *who, double t1, double eps, const sicm_ode_step_type *T) {
     if (!recording_integration_sites()) return;
-    record_integration_site(IntegrationSite{
-        source_name(cb.loc.file) + ":" + std::to_string(cb.loc.line) + ":" +
-            std::to_string(cb.loc.col),
-        who, cb.kernel ? cb.kernel->fn : nullptr, y, shape.time_first(), t0, t1, eps,
-        sicm_ode_step_type_name(T)});
+    record_integration_site(
+        IntegrationSite{source_name(cb.loc.file) + ":" + std::to_string(cb.loc.line) + ":" +
+                            std::to_string(cb.loc.col),
+                        who, cb.kernel ? cb.kernel->fn : nullptr, y, shape.time_first(), t0, t1,
+                        eps, sicm_ode_step_type_name(T)});
   }
 
   // Advance the integrator to t1; errors at the call site on failure.
@@ -680,7 +714,7 @@ Value advance_state(NativeProc *self, Value *a, int n) {
   double dt = arg_finite(a, 1, who);
   double eps = arg_tolerance(a, n, 2, kAdvancerTolerance, who);
   const sicm_ode_step_type *T = arg_integrator(a, n, 3, who);
-  OdeProblem p(loc, who, self->a, a[0], 1);
+  OdeProblem p(loc, who, self->a, a[0], 1, T == sicm_ode_step_taylor);
   double t = p.t0, t1 = p.t0 + dt;
   p.record_site(who, t1, eps, T);
   {
@@ -741,7 +775,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   double t_final = arg_finite(a, 3, who);
   double eps = arg_tolerance(a, n, 4, kAdvancerTolerance, who);
   const sicm_ode_step_type *T = arg_integrator(a, n, 5, who);
-  OdeProblem p(loc, who, self->a, a[0], 1);
+  OdeProblem p(loc, who, self->a, a[0], 1, T == sicm_ode_step_taylor);
   if (dt == 0 && t_final != p.t0) bad_range(a[2], 3, who);
   p.record_site(who, t_final, eps, T);
   const double step = std::fabs(dt) * (t_final >= p.t0 ? 1.0 : -1.0);

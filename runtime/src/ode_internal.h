@@ -7,7 +7,8 @@
 #include "sicm/runtime.h"
 
 /* A step type is a small table of functions (a "backend"). ode.c implements
- * the GSL steppers, ode_bs.c Bulirsch-Stoer, ode_cvode.c CVODE. The driver
+ * the GSL steppers, ode_bs.c Bulirsch-Stoer, ode_cvode.c CVODE, ode_taylor.c
+ * Taylor series from generated coefficients. The driver
  * in ode.c validates arguments, notices when the caller has moved the
  * state between calls, and keeps statistics of rhs calls; the backend does
  * the stepping.
@@ -74,6 +75,10 @@ struct sicm_ode {
   double *probe_work; /* y_start, y_bad (dim each), values at both (probe_count each) */
   double t_start, t_bad;
   int have_bad;
+
+  /* sicm_ode_set_taylor: the Taylor coefficients of the solution (NULL: none). */
+  sicm_ode_taylor_coefficients taylor;
+  const double *taylor_params;
 
   int horizon_set; /* sicm_ode_set_horizon: where the caller is going */
   double horizon;
@@ -144,5 +149,6 @@ int sicm_ode_finite(size_t n, const double *v);
 extern const sicm_ode_step_type sicm_ode_bs_type;
 extern const sicm_ode_step_type sicm_ode_cvode_adams_type;
 extern const sicm_ode_step_type sicm_ode_cvode_bdf_type;
+extern const sicm_ode_step_type sicm_ode_taylor_type;
 
 #endif /* SICM_ODE_INTERNAL_H */

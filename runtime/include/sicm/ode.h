@@ -58,7 +58,16 @@ typedef int (*sicm_ode_jacobian)(double t, const double *y, double *dfdy, double
  *                              checks, at its starting point, that the q part
  *                              does not depend on t or q nor the p part on p,
  *                              and fails with SICM_EINVAL ("the system is not
- *                              separable") otherwise. */
+ *                              separable") otherwise.
+ *   sicm_ode_step_taylor       Taylor series of high order from a coefficient
+ *                              function (sicm_ode_set_taylor), which the compiler
+ *                              generates from the system derivative's code. Order
+ *                              and step from the tolerance (Jorba-Zou): order
+ *                              p = ceil(-ln(tol)/2) + 1, tol the smaller non-zero
+ *                              tolerance; step from the sizes of the last two
+ *                              coefficients. Explicit; no stiffness watch. One
+ *                              Taylor expansion counts as one rhs evaluation in
+ *                              the statistics (it costs a few). */
 typedef struct sicm_ode_step_type sicm_ode_step_type;
 
 extern const sicm_ode_step_type *const sicm_ode_step_rk8pd;
@@ -72,6 +81,7 @@ extern const sicm_ode_step_type *const sicm_ode_step_verlet;
 extern const sicm_ode_step_type *const sicm_ode_step_yoshida4;
 extern const sicm_ode_step_type *const sicm_ode_step_yoshida6;
 extern const sicm_ode_step_type *const sicm_ode_step_yoshida8;
+extern const sicm_ode_step_type *const sicm_ode_step_taylor;
 
 /* sicm_ode_step_type_name returns the type's short name ("rk8pd", "bs",
  * "cvode-bdf", ...), as used in messages. */
@@ -192,6 +202,21 @@ int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y);
 typedef void (*sicm_ode_probe)(const double *y, double *values, const double *params);
 int sicm_ode_set_singularity_probe(sicm_ode *o, sicm_ode_probe probe, const double *params,
                                    size_t n, const char *const *texts);
+
+/* sicm_ode_set_taylor gives sicm_ode_step_taylor its coefficient function:
+ * coefficients(y, order, c, params) stores in c[k * dim + i] the k-th
+ * normalized Taylor coefficient y_i^(k) / k! of the solution through the
+ * state y, for k = 0..order (c[i] = y[i]); order is at most
+ * SICM_ODE_TAYLOR_MAX_ORDER. The system must be autonomous (time, if it
+ * matters, one of the components of y): the coefficients do not depend on
+ * the integrator's t. params must outlive o. Without a coefficient function
+ * the taylor method's evolve fails with SICM_EINVAL; the other methods
+ * ignore it. Returns SICM_SUCCESS. */
+#define SICM_ODE_TAYLOR_MAX_ORDER 40
+typedef void (*sicm_ode_taylor_coefficients)(const double *y, int order, double *c,
+                                             const double *params);
+int sicm_ode_set_taylor(sicm_ode *o, sicm_ode_taylor_coefficients coefficients,
+                        const double *params);
 
 /* sicm_ode_set_horizon tells the integrator that the caller will go on
  * calling sicm_ode_evolve towards t_end (a loop that stops every dt to
