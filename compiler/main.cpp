@@ -62,9 +62,18 @@ const char kUsage[] =
     "                            --param sets (parameter 'NAME default); --stats\n"
     "                            prints what each integration cost on stderr (so\n"
     "                            do built programs given --stats)\n"
-    "       sicm build FILE [-o EXE] [-O0|-O1|-O2|-O3] [--keep-c]\n"
+    "       sicm build FILE [-o EXE] [-O0|-O1|-O2|-O3] [--keep-c] [--report[=PATH]]\n"
+    "                  [--fix NAME=VALUE ...]\n"
     "                            compile to an executable (default: FILE without\n"
     "                            .sicm); --keep-c leaves the C as EXE.c\n"
+    "                            --report[=PATH] also writes what each kernel\n"
+    "                            computes, as JSON (default PATH: EXE.report.json);\n"
+    "                            --fix makes (parameter 'NAME ...) the constant VALUE\n"
+    "                            (also for emit-c and report)\n"
+    "       sicm report FILE [--report=PATH]\n"
+    "                            print what each kernel of the built program computes\n"
+    "                            (op counts of its C) and write the JSON (default:\n"
+    "                            FILE without .sicm, .report.json)\n"
     "       sicm emit-c FILE     print the C that sicm build compiles\n"
     "       sicm emit-kernels FILE\n"
     "                            run the program quietly and print the C of every\n"
@@ -245,16 +254,29 @@ int dispatch(const std::vector<std::string> &args) {
     }
     return emit_c(args[1]);
   }
-  if (cmd == "build" || cmd == "emit-c") {
+  if (cmd == "build" || cmd == "emit-c" || cmd == "report") {
     sicm::BuildOptions o;
     o.emit_only = cmd == "emit-c";
+    o.report_only = cmd == "report";
+    bool want_report = o.report_only;
     for (size_t i = 1; i < args.size(); ++i) {
       const std::string &a = args[i];
-      if (a == "-o" && i + 1 < args.size() && !o.emit_only) {
+      std::string why;
+      if (a == "--fix" && i + 1 < args.size()) {
+        if (!sicm::fix_parameter_option(args[++i], &why)) {
+          std::fprintf(stderr, "sicm: %s\n", why.c_str());
+          return kExitUsage;
+        }
+      } else if (a == "--report" && cmd == "build") {
+        want_report = true;
+      } else if (a.rfind("--report=", 0) == 0 && cmd != "emit-c" && a.size() > 9) {
+        want_report = true;
+        o.report_path = a.substr(9);
+      } else if (a == "-o" && i + 1 < args.size() && cmd == "build") {
         o.output = args[++i];
-      } else if (!o.emit_only && (a == "-O0" || a == "-O1" || a == "-O2" || a == "-O3")) {
+      } else if (cmd == "build" && (a == "-O0" || a == "-O1" || a == "-O2" || a == "-O3")) {
         o.opt_level = a;
-      } else if (a == "--keep-c" && !o.emit_only) {
+      } else if (a == "--keep-c" && cmd == "build") {
         o.keep_c = true;
       } else if (o.input.empty() && a.rfind("-", 0) != 0) {
         o.input = a;
@@ -274,6 +296,7 @@ int dispatch(const std::vector<std::string> &args) {
       else
         o.output += ".out";
     }
+    if (want_report && o.report_path.empty()) o.report_path = o.output + ".report.json";
     return sicm::build_program(o);
   }
   if (cmd == "run") {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "codegen/jit.hpp"
+#include "codegen/kernel_report.hpp"
 #include "codegen/residual_emit.hpp"
 #include "eval/build.hpp"
 #include "eval/core.hpp"
@@ -112,6 +113,20 @@ int build_program(const BuildOptions &o) {
   run_source(file);
   std::string c = emit_residual_program(program);
 
+  if (!o.report_path.empty()) {
+    std::vector<KernelReport> kernels = report_kernels(program, c);
+    std::ofstream json(o.report_path, std::ios::binary);
+    json << report_json(kernels, {});
+    if (!json) {
+      std::fprintf(stderr, "sicm: error: cannot write %s\n", o.report_path.c_str());
+      return kExitCantCreat;
+    }
+    if (o.report_only) {
+      std::fputs(report_table(kernels).c_str(), stdout);
+      std::printf("wrote %s\n", o.report_path.c_str());
+      return 0;
+    }
+  }
   if (o.emit_only) {
     std::fwrite(c.data(), 1, c.size(), stdout);
     return 0;

@@ -15,8 +15,10 @@ struct BuildOptions {
   std::string input;
   std::string output; // the executable; empty for emit-c
   std::string opt_level = "-O2";
-  bool keep_c = false;    // leave OUTPUT.c beside the executable
-  bool emit_only = false; // print the C on stdout instead of compiling
+  bool keep_c = false;      // leave OUTPUT.c beside the executable
+  bool emit_only = false;   // print the C on stdout instead of compiling
+  bool report_only = false; // sicm report: print the kernels' table, write report_path
+  std::string report_path;  // where to write the kernels' JSON (kernel_report.hpp); empty: none
 };
 
 // Returns the process exit status (0 on success). Errors in the program

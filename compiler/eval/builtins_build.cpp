@@ -56,6 +56,7 @@
 #include "eval/limits.hpp"
 #include "eval/number.hpp"
 #include "eval/numerics_defaults.hpp"
+#include "eval/parameter.hpp"
 #include "eval/plot.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
@@ -551,10 +552,14 @@ Value P_runtime(Value *, int) {
   return let(RCompute::RunTime, {}, RType::Real);
 }
 
-// A parameter stays a run-time value: ./prog --param name=value sets it.
+// A parameter stays a run-time value: ./prog --param name=value sets it;
+// sicm build --fix name=value makes it that constant instead, so that terms
+// it zeroes fold away.
 Value P_parameter(Value *a, int) {
   if (!is_symbol(a[0])) wrong_type(a[0], 1, "parameter");
   if (!is_number(a[1])) wrong_type(a[1], 2, "parameter");
+  double fixed;
+  if (fixed_parameter(symbol_name(a[0]), &fixed)) return Value::flonum(fixed);
   if (g_open.size() > 1)
     cannot_compile(here(), "a parameter declared inside a procedure that runs at run time "
                            "(declare it at top level)");

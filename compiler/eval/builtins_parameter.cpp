@@ -18,6 +18,26 @@ namespace sicm {
 namespace {
 
 std::map<std::string, double> g_given; // from --param, by name
+std::map<std::string, double> g_fixed; // from --fix (sicm build), by name
+
+// NAME=VALUE, VALUE a real number in C syntax; the option's name for messages.
+bool parse_assignment(const std::string &assignment, const char *option, std::string *name,
+                      double *x, std::string *why_not) {
+  size_t eq = assignment.find('=');
+  if (eq == 0 || eq == std::string::npos) {
+    *why_not = std::string(option) + " wants NAME=VALUE, not '" + assignment + "'";
+    return false;
+  }
+  std::string value = assignment.substr(eq + 1);
+  char *end = nullptr;
+  *x = std::strtod(value.c_str(), &end);
+  if (value.empty() || *end != '\0') {
+    *why_not = std::string(option) + " " + assignment + ": '" + value + "' is not a number";
+    return false;
+  }
+  *name = assignment.substr(0, eq);
+  return true;
+}
 
 Value P_parameter(Value *a, int) {
   if (!is_symbol(a[0])) wrong_type(a[0], 1, "parameter");
@@ -30,19 +50,25 @@ Value P_parameter(Value *a, int) {
 } // namespace
 
 bool set_parameter_option(const std::string &assignment, std::string *why_not) {
-  size_t eq = assignment.find('=');
-  if (eq == 0 || eq == std::string::npos) {
-    *why_not = "--param wants NAME=VALUE, not '" + assignment + "'";
-    return false;
-  }
-  std::string value = assignment.substr(eq + 1);
-  char *end = nullptr;
-  double x = std::strtod(value.c_str(), &end);
-  if (value.empty() || *end != '\0') {
-    *why_not = "--param " + assignment + ": '" + value + "' is not a number";
-    return false;
-  }
-  g_given[assignment.substr(0, eq)] = x;
+  std::string name;
+  double x;
+  if (!parse_assignment(assignment, "--param", &name, &x, why_not)) return false;
+  g_given[name] = x;
+  return true;
+}
+
+bool fix_parameter_option(const std::string &assignment, std::string *why_not) {
+  std::string name;
+  double x;
+  if (!parse_assignment(assignment, "--fix", &name, &x, why_not)) return false;
+  g_fixed[name] = x;
+  return true;
+}
+
+bool fixed_parameter(const std::string &name, double *value) {
+  auto it = g_fixed.find(name);
+  if (it == g_fixed.end()) return false;
+  *value = it->second;
   return true;
 }
 

@@ -9,6 +9,14 @@ namespace sicm {
 // a reason for anything else.
 bool set_parameter_option(const std::string &assignment, std::string *why_not);
 
+// Record `--fix NAME=VALUE` for sicm build: the parameter becomes the
+// compile-time constant VALUE (terms it zeroes fold away) instead of a
+// run-time input. False and a reason for a malformed assignment.
+bool fix_parameter_option(const std::string &assignment, std::string *why_not);
+
+// The value --fix gave the parameter `name`, if it did.
+bool fixed_parameter(const std::string &name, double *value);
+
 // (parameter name default). Called by init_interpreter.
 void install_parameter_primitives();
 
