@@ -5,7 +5,9 @@
 // derivative, the initial state, the interval and the tolerance and method
 // the program asked for. work_precision.hpp then integrates each again with
 // every method and tolerance. A site whose derivative was not compiled (it
-// could not be traced) is recorded without a kernel and reported as such.
+// could not be traced) is recorded without a kernel and reported as such;
+// while sites are recorded, derivatives are compiled with their Taylor
+// coefficients too, so that 'taylor can be benchmarked.
 #pragma once
 
 #include <string>
@@ -19,6 +21,7 @@ struct IntegrationSite {
   std::string where;     // file:line:col of the call
   std::string who;       // evolve, state-advancer
   KernelFn kernel;       // the system derivative (loaded code is never unloaded), or null
+  TaylorFn taylor;       // its Taylor coefficients (for 'taylor), or null
   std::vector<double> y; // the initial state's leaves
   bool time_first;       // y[0] is the time
   double t0, t1;         // the interval, in the integrator's time

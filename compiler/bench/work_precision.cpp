@@ -21,8 +21,8 @@ namespace {
 
 // Every adaptive method sicm has (the fixed-step symplectic methods take a
 // step size, not a tolerance).
-const char *const kAdaptiveMethods[] = {"bulirsch-stoer", "rk8pd",       "rkf45",    "rkck",
-                                        "msbdf",          "cvode-adams", "cvode-bdf"};
+const char *const kAdaptiveMethods[] = {"bulirsch-stoer", "rk8pd", "rkf45",       "rkck",
+                                        "taylor",         "msbdf", "cvode-adams", "cvode-bdf"};
 
 // Tried in order for the reference (see run_work_precision).
 const char *const kReferenceMethods[] = {"bulirsch-stoer", "rk8pd", "cvode-bdf"};
@@ -57,6 +57,7 @@ Run integrate_once(const IntegrationSite &site, const sicm_ode_step_type *T, dou
   sicm_ode *o = sicm_ode_alloc(T, site.y.size(), call_kernel, &fn, tolerance, tolerance);
   r.final = site.y;
   if (!o) return r;
+  if (T == sicm_ode_step_taylor && site.taylor) sicm_ode_set_taylor(o, site.taylor, nullptr);
   double t = site.t0;
   const double start = sicm_stats_clock();
   r.ok = sicm_ode_evolve(o, &t, site.t1, r.final.data()) == SICM_SUCCESS;
@@ -220,16 +221,27 @@ int run_work_precision(const BenchOptions &options) {
       std::printf("  not benchmarked: its system derivative could not be compiled\n");
       continue;
     }
-    // The reference: the first of these methods that gets through at the
-    // reference tolerance (an explicit method stops on a stiff system); its
-    // error is estimated by its distance from the next that does.
+    // The reference: the Taylor integrator at a tenth of the reference
+    // tolerance when the derivative has Taylor coefficients (its error
+    // estimated by its distance from itself at the reference tolerance: the
+    // most accurate double-precision method sicm has); else the first of
+    // kReferenceMethods that gets through at the reference tolerance (an
+    // explicit method stops on a stiff system), its error estimated by its
+    // distance from the next that does.
     std::vector<Run> candidates;
     candidates.reserve(3); // `reference` below stays valid while one more is added
+    if (site.taylor) {
+      Run best = integrate_once(site, sicm_ode_step_taylor, kReferenceTolerance / 10);
+      Run next = integrate_once(site, sicm_ode_step_taylor, kReferenceTolerance);
+      best.method = "taylor at " + short_number(kReferenceTolerance / 10);
+      next.method = "taylor at " + short_number(kReferenceTolerance);
+      if (best.ok && next.ok) candidates = {std::move(best), std::move(next)};
+    }
     for (const char *m : kReferenceMethods) {
+      if (candidates.size() == 2) break;
       Run r = integrate_once(site, integrator_named(m), kReferenceTolerance);
       r.method = m;
       if (r.ok) candidates.push_back(std::move(r));
-      if (candidates.size() == 2) break;
     }
     if (candidates.empty()) {
       std::printf("  not benchmarked: no method reaches the end at tolerance %s\n",
@@ -245,8 +257,11 @@ int run_work_precision(const BenchOptions &options) {
     }
     const double reference_error =
         candidates.size() > 1 ? distance(reference.final, candidates[1].final) : INFINITY;
-    std::printf("  reference: %s at tolerance %s; its estimated error %s (its distance from %s)\n",
-                reference.method.c_str(), short_number(kReferenceTolerance).c_str(),
+    std::printf("  reference: %s%s; its estimated error %s (its distance from %s)\n",
+                reference.method.c_str(),
+                reference.method.find(" at ") == std::string::npos
+                    ? (" at tolerance " + short_number(kReferenceTolerance)).c_str()
+                    : "",
                 short_number(reference_error).c_str(),
                 candidates.size() > 1 ? candidates[1].method.c_str() : "nothing else");
     std::vector<Run> runs;

@@ -7,11 +7,13 @@
 // integration alone (median of the repeats, at least 3 when a run takes
 // under a second), the accepted and rejected steps and the rhs evaluations
 // (sicm_ode_stats), and the error of the final state: the largest
-// |x - x_ref| over its components, against a reference computed at the
-// tightest tolerance the methods accept (Bulirsch-Stoer at kReferenceTolerance,
-// or rk8pd or cvode-bdf if it fails, as on a stiff system; its own error
-// estimated by its distance from the next of them). A run that fails (step size too small, too many steps, a stiff
-// system) is a row with error inf and the state where it stopped.
+// |x - x_ref| over its components, against a reference: the Taylor
+// integrator at kReferenceTolerance / 10 when the derivative has Taylor
+// coefficients (its error estimated by its distance from itself at
+// kReferenceTolerance), else Bulirsch-Stoer at kReferenceTolerance, or rk8pd
+// or cvode-bdf if it fails, as on a stiff system (its error estimated by its
+// distance from the next of them). The estimate is printed. A run that fails (step size too small,
+// too many steps, a stiff system) is a row with error inf and the state where it stopped.
 //
 // Writes DIR/work-precision.tsv (header, then one row per run: site method
 // tolerance seconds steps rhs_evals error final), DIR/work-precision.svg

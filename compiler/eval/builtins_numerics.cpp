@@ -651,11 +651,11 @@ struct OdeProblem {
   // For sicm bench: this integration, from the current state over [t0, t1].
   void record_site(const char *who, double t1, double eps, const sicm_ode_step_type *T) {
     if (!recording_integration_sites()) return;
-    record_integration_site(
-        IntegrationSite{source_name(cb.loc.file) + ":" + std::to_string(cb.loc.line) + ":" +
-                            std::to_string(cb.loc.col),
-                        who, cb.kernel ? cb.kernel->fn : nullptr, y, shape.time_first(), t0, t1,
-                        eps, sicm_ode_step_type_name(T)});
+    record_integration_site(IntegrationSite{
+        source_name(cb.loc.file) + ":" + std::to_string(cb.loc.line) + ":" +
+            std::to_string(cb.loc.col),
+        who, cb.kernel ? cb.kernel->fn : nullptr, cb.kernel ? cb.kernel->taylor : nullptr, y,
+        shape.time_first(), t0, t1, eps, sicm_ode_step_type_name(T)});
   }
 
   // Advance the integrator to t1; errors at the call site on failure.
@@ -714,7 +714,8 @@ Value advance_state(NativeProc *self, Value *a, int n) {
   double dt = arg_finite(a, 1, who);
   double eps = arg_tolerance(a, n, 2, kAdvancerTolerance, who);
   const sicm_ode_step_type *T = arg_integrator(a, n, 3, who);
-  OdeProblem p(loc, who, self->a, a[0], 1, T == sicm_ode_step_taylor);
+  OdeProblem p(loc, who, self->a, a[0], 1,
+               T == sicm_ode_step_taylor || recording_integration_sites());
   double t = p.t0, t1 = p.t0 + dt;
   p.record_site(who, t1, eps, T);
   {
@@ -775,7 +776,8 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   double t_final = arg_finite(a, 3, who);
   double eps = arg_tolerance(a, n, 4, kAdvancerTolerance, who);
   const sicm_ode_step_type *T = arg_integrator(a, n, 5, who);
-  OdeProblem p(loc, who, self->a, a[0], 1, T == sicm_ode_step_taylor);
+  OdeProblem p(loc, who, self->a, a[0], 1,
+               T == sicm_ode_step_taylor || recording_integration_sites());
   if (dt == 0 && t_final != p.t0) bad_range(a[2], 3, who);
   p.record_site(who, t_final, eps, T);
   const double step = std::fabs(dt) * (t_final >= p.t0 ? 1.0 : -1.0);
