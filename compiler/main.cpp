@@ -121,6 +121,15 @@ void collect_kernel(const sicm::Kernel *k) {
   g_emitted += "/* ---- kernel " + k->c_name + " ---- */\n" + k->c_source + "\n";
 }
 
+// FILE.sicm without its extension (what a program's outputs are named
+// after); any other name unchanged.
+std::string without_sicm_extension(const std::string &file) {
+  const std::string ext = ".sicm";
+  if (file.size() > ext.size() && file.compare(file.size() - ext.size(), ext.size(), ext) == 0)
+    return file.substr(0, file.size() - ext.size());
+  return file;
+}
+
 // Run a program with its output discarded and its plots in a scratch
 // directory, removed afterwards (sicm emit-kernels, sicm bench).
 int run_quietly(const std::string &path) {
@@ -207,12 +216,7 @@ int bench(const std::vector<std::string> &args) {
     std::fputs(kUsage, stderr);
     return kExitUsage;
   }
-  if (o.out_dir.empty()) {
-    o.out_dir = file;
-    if (o.out_dir.size() > 5 && o.out_dir.compare(o.out_dir.size() - 5, 5, ".sicm") == 0)
-      o.out_dir.resize(o.out_dir.size() - 5);
-    o.out_dir += "-bench";
-  }
+  if (o.out_dir.empty()) o.out_dir = without_sicm_extension(file) + "-bench";
   sicm::record_integration_sites(true);
   int status = run_quietly(file);
   sicm::record_integration_sites(false);
@@ -290,11 +294,8 @@ int dispatch(const std::vector<std::string> &args) {
       return kExitUsage;
     }
     if (o.output.empty()) {
-      o.output = o.input;
-      if (o.output.size() > 5 && o.output.compare(o.output.size() - 5, 5, ".sicm") == 0)
-        o.output.resize(o.output.size() - 5);
-      else
-        o.output += ".out";
+      o.output = without_sicm_extension(o.input);
+      if (o.output == o.input) o.output += ".out";
     }
     if (want_report && o.report_path.empty()) o.report_path = o.output + ".report.json";
     return sicm::build_program(o);

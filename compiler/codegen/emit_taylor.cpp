@@ -418,33 +418,32 @@ static inline void sicm_tc_log(double *v, const double *u, int k) {
   v[k] = (u[k] - s / k) / u[0];
 }
 
-static inline void sicm_tc_sincos(double *s, double *c, const double *u, int k) {
-  if (k == 0) {
-    sincos(u[0], &s[0], &c[0]);
-    return;
-  }
+/* The pair s, c with s' = c u' and c' = sign s u' (sin and cos: sign -1;
+ * sinh and cosh: sign +1), at order k >= 1. */
+static inline void sicm_tc_pair(double *s, double *c, const double *u, int k, double sign) {
   double a = 0, b = 0;
   for (int j = 1; j <= k; ++j) {
     a += j * u[j] * c[k - j];
     b += j * u[j] * s[k - j];
   }
   s[k] = a / k;
-  c[k] = -b / k;
+  c[k] = sign * b / k;
+}
+
+static inline void sicm_tc_sincos(double *s, double *c, const double *u, int k) {
+  if (k == 0)
+    sincos(u[0], &s[0], &c[0]);
+  else
+    sicm_tc_pair(s, c, u, k, -1.0);
 }
 
 static inline void sicm_tc_sinhcosh(double *s, double *c, const double *u, int k) {
   if (k == 0) {
     s[0] = sinh(u[0]);
     c[0] = cosh(u[0]);
-    return;
+  } else {
+    sicm_tc_pair(s, c, u, k, 1.0);
   }
-  double a = 0, b = 0;
-  for (int j = 1; j <= k; ++j) {
-    a += j * u[j] * c[k - j];
-    b += j * u[j] * s[k - j];
-  }
-  s[k] = a / k;
-  c[k] = b / k;
 }
 
 /* v = atan2(y, x): r v' = x y' - y x' with r = x^2 + y^2 (kept in r). */

@@ -227,9 +227,7 @@ std::vector<KernelReport> report_kernels(const ResidualProgram &program,
     auto use = uses.find(static_cast<int>(f));
     r.role = use == uses.end() ? "other" : use->second.role;
     SrcLoc loc = use == uses.end() ? fn.loc : use->second.loc;
-    r.site = loc.known() ? source_name(loc.file) + ":" + std::to_string(loc.line) + ":" +
-                               std::to_string(loc.col)
-                         : "?";
+    r.site = loc.known() ? loc_text(loc) : "?";
     r.inputs = fn.inputs.size();
     r.outputs = fn.outputs.size();
     std::vector<ExprId> exprs = fn.outputs;

@@ -276,9 +276,7 @@ private:
 
   std::string site(const SrcLoc &loc) {
     std::string name = "site" + std::to_string(nsites_++);
-    std::string where = loc.known() ? source_name(loc.file) + ":" + std::to_string(loc.line) + ":" +
-                                          std::to_string(loc.col)
-                                    : p_.source_name;
+    std::string where = loc.known() ? loc_text(loc) : p_.source_name;
     std::string line = loc.known() ? std::string(source_line(loc.file, loc.line)) : "";
     sites_ += "static const sicm_site " + name + " = {" + c_string_literal(where) + ", " +
               c_string_literal(line) + ", " + std::to_string(loc.known() ? loc.col : 0) + "};\n";

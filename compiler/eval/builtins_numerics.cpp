@@ -439,9 +439,7 @@ struct OdeDeleter {
   const double *seconds = nullptr;
   void operator()(sicm_ode *o) const {
     if (sicm_stats_enabled() && seconds) {
-      std::string where =
-          source_name(loc.file) + ":" + std::to_string(loc.line) + ":" + std::to_string(loc.col);
-      sicm_stats_add(where.c_str(), who, sicm_ode_name(o), tolerance, sicm_ode_get_stats(o),
+      sicm_stats_add(loc_text(loc).c_str(), who, sicm_ode_name(o), tolerance, sicm_ode_get_stats(o),
                      *seconds);
     }
     sicm_ode_free(o);
@@ -651,11 +649,10 @@ struct OdeProblem {
   // For sicm bench: this integration, from the current state over [t0, t1].
   void record_site(const char *who, double t1, double eps, const sicm_ode_step_type *T) {
     if (!recording_integration_sites()) return;
-    record_integration_site(IntegrationSite{
-        source_name(cb.loc.file) + ":" + std::to_string(cb.loc.line) + ":" +
-            std::to_string(cb.loc.col),
-        who, cb.kernel ? cb.kernel->fn : nullptr, cb.kernel ? cb.kernel->taylor : nullptr, y,
-        shape.time_first(), t0, t1, eps, sicm_ode_step_type_name(T)});
+    record_integration_site(
+        IntegrationSite{loc_text(cb.loc), who, cb.kernel ? cb.kernel->fn : nullptr,
+                        cb.kernel ? cb.kernel->taylor : nullptr, y, shape.time_first(), t0, t1, eps,
+                        sicm_ode_step_type_name(T)});
   }
 
   // Advance the integrator to t1; errors at the call site on failure.

@@ -14,8 +14,7 @@ void runtime_error(SrcLoc loc, const std::string &msg) {
 std::string format_error(const Error &e) {
   std::string out;
   if (e.loc.known()) {
-    out += source_name(e.loc.file) + ":" + std::to_string(e.loc.line) + ":" +
-           std::to_string(e.loc.col) + ": ";
+    out += loc_text(e.loc) + ": ";
   }
   out += "error: ";
   out += e.what();

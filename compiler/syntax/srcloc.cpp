@@ -21,6 +21,10 @@ uint32_t register_source(std::string name, std::string text) {
   return static_cast<uint32_t>(sources().size() - 1);
 }
 
+std::string loc_text(SrcLoc loc) {
+  return source_name(loc.file) + ":" + std::to_string(loc.line) + ":" + std::to_string(loc.col);
+}
+
 const std::string &source_name(uint32_t file) {
   return sources().at(file < sources().size() ? file : 0).name;
 }

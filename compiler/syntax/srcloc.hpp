@@ -18,6 +18,8 @@ struct SrcLoc {
 // The registry of source texts, so that diagnostics can quote the line.
 uint32_t register_source(std::string name, std::string text);
 const std::string &source_name(uint32_t file);
+// "file:line:col", as diagnostics and run-time sites name a place (loc must be known).
+std::string loc_text(SrcLoc loc);
 const std::string &source_text(uint32_t file);
 // The text of line `line` of `file` without its newline ("" if out of range).
 std::string_view source_line(uint32_t file, uint32_t line);
