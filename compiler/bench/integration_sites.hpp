@@ -18,13 +18,14 @@
 namespace sicm {
 
 struct IntegrationSite {
-  std::string where;     // file:line:col of the call
-  std::string who;       // evolve, state-advancer
-  KernelFn kernel;       // the system derivative (loaded code is never unloaded), or null
-  TaylorFn taylor;       // its Taylor coefficients (for 'taylor), or null
-  std::vector<double> y; // the initial state's leaves
-  bool time_first;       // y[0] is the time
-  double t0, t1;         // the interval, in the integrator's time
+  std::string where; // file:line:col of the call
+  std::string who;   // evolve, state-advancer
+  KernelFn kernel;   // the system derivative (loaded code is never unloaded), or null
+  TaylorFn taylor;   // its Taylor coefficients (for 'taylor), or null
+  TaylorExtendedFn taylor_extended; // the same in long double (for 'taylor-extended)
+  std::vector<double> y;            // the initial state's leaves
+  bool time_first;                  // y[0] is the time
+  double t0, t1;                    // the interval, in the integrator's time
   double tolerance;
   std::string method; // what the program used
 };

@@ -21,8 +21,9 @@ namespace {
 
 // Every adaptive method sicm has (the fixed-step symplectic methods take a
 // step size, not a tolerance).
-const char *const kAdaptiveMethods[] = {"bulirsch-stoer", "rk8pd", "rkf45",       "rkck",
-                                        "taylor",         "msbdf", "cvode-adams", "cvode-bdf"};
+const char *const kAdaptiveMethods[] = {"bulirsch-stoer", "rk8pd",       "rkf45",
+                                        "rkck",           "taylor",      "taylor-extended",
+                                        "msbdf",          "cvode-adams", "cvode-bdf"};
 
 // Tried in order for the reference (see run_work_precision).
 const char *const kReferenceMethods[] = {"bulirsch-stoer", "rk8pd", "cvode-bdf"};
@@ -58,6 +59,8 @@ Run integrate_once(const IntegrationSite &site, const sicm_ode_step_type *T, dou
   r.final = site.y;
   if (!o) return r;
   if (T == sicm_ode_step_taylor && site.taylor) sicm_ode_set_taylor(o, site.taylor, nullptr);
+  if (T == sicm_ode_step_taylor_extended && site.taylor_extended)
+    sicm_ode_set_taylor_extended(o, site.taylor_extended, nullptr);
   double t = site.t0;
   const double start = sicm_stats_clock();
   r.ok = sicm_ode_evolve(o, &t, site.t1, r.final.data()) == SICM_SUCCESS;
@@ -221,20 +224,20 @@ int run_work_precision(const BenchOptions &options) {
       std::printf("  not benchmarked: its system derivative could not be compiled\n");
       continue;
     }
-    // The reference: the Taylor integrator at a tenth of the reference
-    // tolerance when the derivative has Taylor coefficients (its error
-    // estimated by its distance from itself at the reference tolerance: the
-    // most accurate double-precision method sicm has); else the first of
-    // kReferenceMethods that gets through at the reference tolerance (an
-    // explicit method stops on a stiff system), its error estimated by its
-    // distance from the next that does.
+    // The reference: the Taylor integrator in long double well under the
+    // rounding of double when the derivative has Taylor coefficients (its
+    // error estimated by its distance from itself at ten times the
+    // tolerance); else the first of kReferenceMethods that gets through at
+    // the reference tolerance (an explicit method stops on a stiff system),
+    // its error estimated by its distance from the next that does.
     std::vector<Run> candidates;
     candidates.reserve(3); // `reference` below stays valid while one more is added
-    if (site.taylor) {
-      Run best = integrate_once(site, sicm_ode_step_taylor, kReferenceTolerance / 10);
-      Run next = integrate_once(site, sicm_ode_step_taylor, kReferenceTolerance);
-      best.method = "taylor at " + short_number(kReferenceTolerance / 10);
-      next.method = "taylor at " + short_number(kReferenceTolerance);
+    if (site.taylor_extended) {
+      const double tol = kExtendedReferenceTolerance;
+      Run best = integrate_once(site, sicm_ode_step_taylor_extended, tol);
+      Run next = integrate_once(site, sicm_ode_step_taylor_extended, 10 * tol);
+      best.method = "taylor-extended at " + short_number(tol);
+      next.method = "taylor-extended at " + short_number(10 * tol);
       if (best.ok && next.ok) candidates = {std::move(best), std::move(next)};
     }
     for (const char *m : kReferenceMethods) {

@@ -8,11 +8,12 @@
 // under a second), the accepted and rejected steps and the rhs evaluations
 // (sicm_ode_stats), and the error of the final state: the largest
 // |x - x_ref| over its components, against a reference: the Taylor
-// integrator at kReferenceTolerance / 10 when the derivative has Taylor
-// coefficients (its error estimated by its distance from itself at
-// kReferenceTolerance), else Bulirsch-Stoer at kReferenceTolerance, or rk8pd
-// or cvode-bdf if it fails, as on a stiff system (its error estimated by its
-// distance from the next of them). The estimate is printed. A run that fails (step size too small,
+// integrator in long double (taylor-extended) at kExtendedReferenceTolerance
+// when the derivative has Taylor coefficients (its error estimated by its
+// distance from itself at 10 times that tolerance, both rounded to double),
+// else Bulirsch-Stoer at kReferenceTolerance, or rk8pd or cvode-bdf if it
+// fails, as on a stiff system (its error estimated by its distance from the
+// next of them). The estimate is printed. A run that fails (step size too small,
 // too many steps, a stiff system) is a row with error inf and the state where it stopped.
 //
 // Writes DIR/work-precision.tsv (header, then one row per run: site method
@@ -30,6 +31,9 @@ namespace sicm {
 // Tighter than every adaptive method's useful range in double precision;
 // the reference's own error is measured, not assumed.
 constexpr double kReferenceTolerance = 1e-15;
+
+// Well under the rounding of double (1.1e-16), within long double's (5.4e-20).
+constexpr double kExtendedReferenceTolerance = 1e-19;
 
 struct BenchOptions {
   std::string out_dir;                                // default: FILE-bench

@@ -36,7 +36,11 @@
 #include "codegen/emit_taylor.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -59,9 +63,23 @@ bool is_zeroth_power(ExprId id) {
   return expr_is_apply(id, Op::Expt) && expr_is_exact_zero(expr_arg(id, 1));
 }
 
+// Is id (expt (sqrt u) a) with a constant exponent that is not a small
+// positive integer? Its coefficients are those of u^(a/2), by one power
+// recurrence instead of a square root's and a power's (the Kepler
+// problem's r^-3 = (x^2 + y^2)^(-3/2)).
+bool is_power_of_root(ExprId id) {
+  if (!expr_is_apply(id, Op::Expt) || !expr_is_apply(expr_arg(id, 0), Op::Sqrt)) return false;
+  ExprId a = expr_arg(id, 1);
+  int64_t n;
+  if (!expr_is_number(a)) return false;
+  return !(expr_get_int64(a, &n) && n >= 1 && n <= kMaxProductPower);
+}
+
 class TaylorEmitter {
 public:
-  TaylorEmitter(const Trace &t) : t_(t) {
+  TaylorEmitter(const Trace &t, TaylorPrecision precision, const SymbolSpeller &spell)
+      : t_(t), extended_(precision == TaylorPrecision::Extended), spell_(spell),
+        real_(extended_ ? "long double" : "double"), tc_(extended_ ? "sicm_tcl_" : "sicm_tc_") {
     for (size_t i = 0; i < t.inputs.size(); ++i)
       input_[t.inputs[i]] = i;
   }
@@ -75,26 +93,51 @@ public:
     collect();
     for (ExprId id : nodes_)
       if (series_.count(id) && !emit_node(id, why_not)) return false;
+    if (!why_not_.empty()) {
+      *why_not = why_not_;
+      return false;
+    }
     *out = assemble(c_name);
     return true;
   }
 
 private:
-  // The nodes reachable from the outputs in increasing id order, and which
-  // of them depend on the state (series_).
+  // The arguments a node's recurrence reads: a power of a root reads the
+  // root's argument.
+  static std::vector<ExprId> operands_of(ExprId id) {
+    std::vector<ExprId> args = expr_arg_vector(id);
+    if (is_power_of_root(id)) args[0] = expr_arg(args[0], 0);
+    return args;
+  }
+
+  // The nodes the recurrences need, reachable from the outputs, in
+  // increasing id order, and which of them have coefficient arrays
+  // (series_): those that depend on the state, and in extended precision
+  // every operation (its constant value is then computed in long double
+  // too, by the recurrence at order 0).
   void collect() {
-    expr_visit(t_.outputs, [&](ExprId id) {
+    std::vector<ExprId> stack(t_.outputs.begin(), t_.outputs.end());
+    std::unordered_set<ExprId> seen;
+    while (!stack.empty()) {
+      ExprId id = stack.back();
+      stack.pop_back();
+      if (!seen.insert(id).second) continue;
       nodes_.push_back(id);
-      return true;
-    });
+      ExprKind kind = expr_kind(id);
+      if (kind == ExprKind::Apply || kind == ExprKind::Call)
+        for (ExprId a : operands_of(id))
+          stack.push_back(a);
+    }
     std::sort(nodes_.begin(), nodes_.end());
     for (ExprId id : nodes_) {
       ExprKind kind = expr_kind(id);
       bool depends = false;
       if (kind == ExprKind::Symbol) depends = input_.count(expr_node(id).sym) > 0;
-      if ((kind == ExprKind::Apply || kind == ExprKind::Call) && !is_zeroth_power(id))
-        for (ExprId a : expr_arg_vector(id))
+      if ((kind == ExprKind::Apply || kind == ExprKind::Call) && !is_zeroth_power(id)) {
+        depends = extended_ && kind == ExprKind::Apply;
+        for (ExprId a : operands_of(id))
           depends = depends || series_.count(a) > 0;
+      }
       if (depends) series_.insert(id);
     }
   }
@@ -124,7 +167,7 @@ private:
     std::string name = array("s");
     spread_[id] = name;
     spread_inits_ +=
-        "  for (int j = 0; j <= order; ++j) " + name + "[j] = j ? 0.0 : " + scalar(id) + ";\n";
+        "  for (int j = 0; j <= order; ++j) " + name + "[j] = j ? 0 : " + scalar(id) + ";\n";
     return name;
   }
 
@@ -134,7 +177,7 @@ private:
   // Coefficient k of any node as a C expression.
   std::string coefficient_k(ExprId id) {
     if (series_.count(id)) return array_of_.at(id) + "[k]";
-    return "(k == 0 ? " + scalar(id) + " : 0.0)";
+    return "(k == 0 ? " + scalar(id) + " : 0)";
   }
 
   void line(const std::string &s) { body_ += "    " + s + "\n"; }
@@ -164,18 +207,18 @@ private:
     case Op::Sub: return emit_sum(v, op, args);
     case Op::Mul: return emit_product(v, args);
     case Op::Div: return emit_quotient(v, args);
-    case Op::Expt: return emit_power(v, args, why_not);
-    case Op::Sqrt: line("sicm_tc_sqrt(" + v + ", " + coefficients(args[0]) + ", k);"); return true;
-    case Op::Exp: line("sicm_tc_exp(" + v + ", " + coefficients(args[0]) + ", k);"); return true;
-    case Op::Log: line("sicm_tc_log(" + v + ", " + coefficients(args[0]) + ", k);"); return true;
+    case Op::Expt: return emit_power(id, v, args, why_not);
+    case Op::Sqrt: line(tc_ + "sqrt(" + v + ", " + coefficients(args[0]) + ", k);"); return true;
+    case Op::Exp: line(tc_ + "exp(" + v + ", " + coefficients(args[0]) + ", k);"); return true;
+    case Op::Log: line(tc_ + "log(" + v + ", " + coefficients(args[0]) + ", k);"); return true;
     case Op::Sin:
-    case Op::Cos: return emit_pair(id, v, Op::Sin, Op::Cos, "sicm_tc_sincos", args[0]);
+    case Op::Cos: return emit_pair(id, v, Op::Sin, Op::Cos, tc_ + "sincos", args[0]);
     case Op::Sinh:
-    case Op::Cosh: return emit_pair(id, v, Op::Sinh, Op::Cosh, "sicm_tc_sinhcosh", args[0]);
+    case Op::Cosh: return emit_pair(id, v, Op::Sinh, Op::Cosh, tc_ + "sinhcosh", args[0]);
     case Op::Atan: {
       std::string y = coefficients(args[0]);
       std::string x = args.size() == 2 ? coefficients(args[1]) : spread(expr_integer(1));
-      line("sicm_tc_atan2(" + v + ", " + y + ", " + x + ", " + array("r") + ", k);");
+      line(tc_ + "atan2(" + v + ", " + y + ", " + x + ", " + array("r") + ", k);");
       return true;
     }
     case Op::Abs:
@@ -226,11 +269,16 @@ private:
     std::string acc = factors[0];
     for (size_t i = 1; i + 1 < factors.size(); ++i) {
       std::string p = array("p");
-      line(p + "[k] = sicm_tc_product(" + acc + ", " + factors[i] + ", k);");
+      line(p + "[k] = " + product(acc, factors[i]) + ";");
       acc = p;
     }
-    line(v + "[k] = " + scale + "sicm_tc_product(" + acc + ", " + factors.back() + ", k);");
+    line(v + "[k] = " + scale + product(acc, factors.back()) + ";");
     return true;
+  }
+
+  // Coefficient k of a * b: a square by its symmetric half.
+  std::string product(const std::string &a, const std::string &b) {
+    return a == b ? tc_ + "square(" + a + ", k)" : tc_ + "product(" + a + ", " + b + ", k)";
   }
 
   // /: by a constant termwise, by a series by the quotient recurrence.
@@ -242,7 +290,7 @@ private:
       bool last = i + 1 == args.size();
       std::string q = last ? v : array("q");
       if (series_.count(args[i]))
-        line("sicm_tc_quotient(" + q + ", " + acc_k + ", " + array_of_.at(args[i]) + ", k);");
+        line(tc_ + "quotient(" + q + ", " + acc_k + ", " + array_of_.at(args[i]) + ", k);");
       else
         line(q + "[k] = " + acc_k + " / " + scalar(args[i]) + ";");
       acc_k = q + "[k]";
@@ -251,11 +299,19 @@ private:
   }
 
   // expt with a constant exponent: products for small positive integers,
-  // the power recurrence otherwise.
-  bool emit_power(const std::string &v, const std::vector<ExprId> &args, std::string *why_not) {
+  // the power recurrence otherwise (of the root's argument for a power of a
+  // root, at half the exponent).
+  bool emit_power(ExprId id, const std::string &v, const std::vector<ExprId> &args,
+                  std::string *why_not) {
     if (series_.count(args[1])) {
       *why_not = "expt with an exponent that depends on the state";
       return false;
+    }
+    if (is_power_of_root(id)) {
+      ExprId half = expr_from_number(num_div(expr_number_value(args[1]), Value::fixnum(2)));
+      line(tc_ + "power(" + v + ", " + coefficients(expr_arg(args[0], 0)) + ", " + scalar(half) +
+           ", k);");
+      return true;
     }
     std::string base = coefficients(args[0]);
     int64_t n;
@@ -263,7 +319,7 @@ private:
       emit_integer_power(v, base, static_cast<uint64_t>(n));
       return true;
     }
-    line("sicm_tc_power(" + v + ", " + base + ", " + scalar(args[1]) + ", k);");
+    line(tc_ + "power(" + v + ", " + base + ", " + scalar(args[1]) + ", k);");
     return true;
   }
 
@@ -281,7 +337,7 @@ private:
         if (acc.empty())
           line(target + "[k] = " + square + "[k];");
         else
-          line(target + "[k] = sicm_tc_product(" + acc + ", " + square + ", k);");
+          line(target + "[k] = " + product(acc, square) + ";");
         acc = target;
       } else {
         m >>= 1;
@@ -289,7 +345,7 @@ private:
       if (m == 0) return;
       bool final_square = m == 1 && acc.empty();
       std::string next = final_square ? v : array("p");
-      line(next + "[k] = sicm_tc_product(" + square + ", " + square + ", k);");
+      line(next + "[k] = " + product(square, square) + ";");
       square = next;
       if (final_square) return;
     }
@@ -297,7 +353,8 @@ private:
 
   // sin and cos (or sinh and cosh) of one argument are computed together;
   // the partner that is not in the DAG gets an array of its own.
-  bool emit_pair(ExprId id, const std::string &v, Op first, Op second, const char *fn, ExprId arg) {
+  bool emit_pair(ExprId id, const std::string &v, Op first, Op second, const std::string &fn,
+                 ExprId arg) {
     bool is_first = expr_is_apply(id, first);
     ExprId other = expr_apply(is_first ? second : first, {arg});
     std::string partner;
@@ -308,7 +365,7 @@ private:
       partner = array("w");
     }
     std::string a = is_first ? v : partner, b = is_first ? partner : v;
-    line(std::string(fn) + "(" + a + ", " + b + ", " + coefficients(arg) + ", k);");
+    line(fn + "(" + a + ", " + b + ", " + coefficients(arg) + ", k);");
     return true;
   }
 
@@ -318,29 +375,77 @@ private:
     for (size_t i = 0; i < n; ++i)
       outs += "    c[(k + 1) * " + std::to_string(n) + " + " + std::to_string(i) +
               "] = " + coefficient_k(t_.outputs[i]) + " / (k + 1);\n";
-    std::string f =
-        "void " + c_name + "(const double *in, int order, double *c, const double *p) {\n";
+    std::string f = "void " + c_name + "(const " + real_ + " *in, int order, " + real_ +
+                    " *c, const double *p) {\n";
     f += "  (void)p;\n";
     f += "  enum { K = " + std::to_string(SICM_ODE_TAYLOR_MAX_ORDER + 1) + " };\n";
     f += "  if (order > K - 1) order = K - 1;\n";
     f += "  if (order < 0) order = 0;\n";
     if (!constants_.empty()) {
       for (const std::string &name : constant_names_)
-        f += "  double " + name + ";\n";
-      auto no_symbol = [](Symbol *) -> std::string {
-        internal_failure(__FILE__, __LINE__, "a constant node with a symbol");
-      };
-      f += emit_c_assignments(constants_, constant_names_, no_symbol, "u", "");
+        f += "  " + real_ + " " + name + ";\n";
+      if (extended_) {
+        for (size_t i = 0; i < constants_.size(); ++i)
+          f += "  " + constant_names_[i] + " = " + extended_constant(constants_[i]) + ";\n";
+      } else {
+        f += emit_c_assignments(constants_, constant_names_, spell_symbol(), "u", "");
+      }
     }
     for (const std::string &a : arrays_)
-      f += "  double " + a + "[K];\n";
+      f += "  " + real_ + " " + a + "[K];\n";
     f += spread_inits_;
     f += "  for (int i = 0; i < " + std::to_string(n) + "; ++i) c[i] = in[i];\n";
     f += "  for (int k = 0; k < order; ++k) {\n" + body_ + outs + "  }\n}\n";
     return f;
   }
 
+  // A symbol that is not an input (a run-time parameter of a built
+  // program) as the caller spells it; an unknown one makes the emitter
+  // give up, since it cannot be evaluated here.
+  std::function<std::string(Symbol *)> spell_symbol() {
+    return [this](Symbol *sym) -> std::string {
+      std::string s = spell_ ? spell_(sym) : "";
+      if (s.empty()) {
+        if (why_not_.empty()) why_not_ = "a value that is not known where the coefficients are";
+        return "0.0";
+      }
+      return s;
+    };
+  }
+
+  // A constant of the extended function, in long double: a number exactly
+  // (an integer or a ratio of integers of at most 64 bits as written, other
+  // numbers as the double they round to, as the double kernels have them),
+  // a parameter converted from the double it is.
+  std::string extended_constant(ExprId id) {
+    const ExprNode &n = expr_node(id);
+    if (n.kind == ExprKind::Symbol) return "(long double)" + spell_symbol()(n.sym);
+    if (n.kind == ExprKind::Rational) {
+      mpq_srcptr q = expr_rat(id);
+      if (mpz_sizeinbase(mpq_numref(q), 2) <= 64 && mpz_sizeinbase(mpq_denref(q), 2) <= 64) {
+        auto digits = [](mpz_srcptr z) {
+          std::string s(mpz_sizeinbase(z, 10) + 2, '\0');
+          mpz_get_str(s.data(), 10, z);
+          s.resize(std::strlen(s.c_str()));
+          return s + ".0L";
+        };
+        std::string num = digits(mpq_numref(q));
+        if (mpz_cmp_ui(mpq_denref(q), 1) == 0) return "(" + num + ")";
+        return "(" + num + " / " + digits(mpq_denref(q)) + ")";
+      }
+    }
+    double d = n.kind == ExprKind::Flonum ? n.d : to_double(expr_number_value(id));
+    if (!std::isfinite(d)) return "(long double)" + c_double_literal(d);
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%aL", d);
+    return buf;
+  }
+
   const Trace &t_;
+  const bool extended_;
+  SymbolSpeller spell_;
+  const std::string real_, tc_;
+  std::string why_not_;
   std::unordered_map<Symbol *, size_t> input_;
   std::vector<ExprId> nodes_; // reachable from the outputs, increasing ids
   std::unordered_set<ExprId> series_;
@@ -353,113 +458,203 @@ private:
 
 } // namespace
 
-std::string emit_taylor_function(const Trace &t, const std::string &c_name, std::string *why_not) {
+std::string emit_taylor_function(const Trace &t, const std::string &c_name, std::string *why_not,
+                                 TaylorPrecision precision, const SymbolSpeller &spell) {
   std::string out, reason;
-  if (TaylorEmitter(t).emit(c_name, &out, &reason)) return out;
+  if (TaylorEmitter(t, precision, spell).emit(c_name, &out, &reason)) return out;
   if (why_not) *why_not = reason;
   return "";
 }
 
 // Each helper computes coefficient k of its result from coefficients 0..k
 // of its arguments and 0..k-1 of the result (k = 0: the value itself).
-std::string c_taylor_support() {
-  return R"(/* Taylor-coefficient recurrences (sicm's Taylor emitter). */
-static inline double sicm_tc_product(const double *a, const double *b, int k) {
-  double s = 0;
-  for (int j = 0; j <= k; ++j) s += a[j] * b[k - j];
-  return s;
+//
+// The sums are convolutions, and a sum accumulated in one variable waits on
+// the latency of each addition (4 cycles) while the multiplications would
+// go at one a cycle: each sum keeps four partial sums (the order of the
+// additions changes, their accuracy does not). Written once over `real`
+// and instantiated for double and long double (taylor-extended).
+static const char kTaylorSupport[] = R"(
+/* sum_{j=lo}^{hi} w(j) a[j] b[k-j], four partial sums; W is the weight. */
+#define SICM_TC_DOT(W)                                                          \
+  real s0 = 0, s1 = 0, s2 = 0, s3 = 0;                                         \
+  int j = lo;                                                                  \
+  for (; j + 3 <= hi; j += 4) {                                                \
+    s0 += W(j) * a[j] * b[k - j];                                              \
+    s1 += W(j + 1) * a[j + 1] * b[k - j - 1];                                  \
+    s2 += W(j + 2) * a[j + 2] * b[k - j - 2];                                  \
+    s3 += W(j + 3) * a[j + 3] * b[k - j - 3];                                  \
+  }                                                                            \
+  for (; j <= hi; ++j) s0 += W(j) * a[j] * b[k - j];                           \
+  return (s0 + s1) + (s2 + s3)
+#define SICM_TC_ONE(j) 1
+#define SICM_TC_J(j) (real)(j)
+
+static inline real tc_dot(const real *a, const real *b, int lo, int hi, int k) {
+  SICM_TC_DOT(SICM_TC_ONE);
+}
+
+/* sum_{j=lo}^{hi} j a[j] b[k-j] */
+static inline real tc_jdot(const real *a, const real *b, int lo, int hi, int k) {
+  SICM_TC_DOT(SICM_TC_J);
+}
+
+static inline real tc_product(const real *a, const real *b, int k) {
+  return tc_dot(a, b, 0, k, k);
+}
+
+/* a * a: the convolution is symmetric, half the products. */
+static inline real tc_square(const real *a, int k) {
+  if (k == 0) return a[0] * a[0];
+  const real *b = a;
+  real half = tc_dot(a, b, 0, (k - 1) / 2, k);
+  return 2 * half + (k % 2 == 0 ? a[k / 2] * a[k / 2] : 0);
 }
 
 /* q = a / b, given a's coefficient k. */
-static inline void sicm_tc_quotient(double *q, double a_k, const double *b, int k) {
-  double s = a_k;
-  for (int j = 1; j <= k; ++j) s -= b[j] * q[k - j];
-  q[k] = s / b[0];
+static inline void tc_quotient(real *q, real a_k, const real *b, int k) {
+  q[k] = (a_k - tc_dot(b, q, 1, k, k)) / b[0];
 }
 
-/* v = u^alpha: u v' = alpha u' v. */
-static inline void sicm_tc_power(double *v, const double *u, double alpha, int k) {
-  if (k == 0) {
-    v[0] = pow(u[0], alpha);
-    return;
-  }
-  double s = 0;
-  for (int j = 0; j < k; ++j) s += (alpha * (k - j) - j) * u[k - j] * v[j];
-  v[k] = s / (k * u[0]);
+/* v = u^alpha: u v' = alpha u' v, so
+ * k u0 v_k = sum_{i=1}^{k} (alpha i - (k - i)) u_i v_{k-i}
+ *          = sum_{i=1}^{k} ((alpha + 1) i - k) u_i v_{k-i}. */
+#define SICM_TC_POWER_WEIGHT(j) (alpha1 * (real)(j) - (real)k)
+static inline real tc_power_dot(const real *a, const real *b, int lo, int hi, int k,
+                                real alpha1) {
+  SICM_TC_DOT(SICM_TC_POWER_WEIGHT);
 }
 
-static inline void sicm_tc_sqrt(double *v, const double *u, int k) {
+static inline void tc_power(real *v, const real *u, real alpha, int k) {
   if (k == 0) {
-    v[0] = sqrt(u[0]);
+    v[0] = POW(u[0], alpha);
     return;
   }
-  double s = u[k];
-  for (int j = 1; j < k; ++j) s -= v[j] * v[k - j];
-  v[k] = s / (2 * v[0]);
+  v[k] = tc_power_dot(u, v, 1, k, k, alpha + 1) / (k * u[0]);
 }
 
-static inline void sicm_tc_exp(double *v, const double *u, int k) {
+static inline void tc_sqrt(real *v, const real *u, int k) {
   if (k == 0) {
-    v[0] = exp(u[0]);
+    v[0] = SQRT(u[0]);
     return;
   }
-  double s = 0;
-  for (int j = 1; j <= k; ++j) s += j * u[j] * v[k - j];
-  v[k] = s / k;
+  /* u_k = sum_{j=0}^{k} v_j v_{k-j}: the inner terms, symmetric. */
+  const real *a = v, *b = v;
+  real inner = 2 * tc_dot(a, b, 1, (k - 1) / 2, k) + (k % 2 == 0 ? v[k / 2] * v[k / 2] : 0);
+  v[k] = (u[k] - inner) / (2 * v[0]);
 }
 
-static inline void sicm_tc_log(double *v, const double *u, int k) {
+static inline void tc_exp(real *v, const real *u, int k) {
   if (k == 0) {
-    v[0] = log(u[0]);
+    v[0] = EXP(u[0]);
     return;
   }
-  double s = 0;
-  for (int j = 1; j < k; ++j) s += j * v[j] * u[k - j];
-  v[k] = (u[k] - s / k) / u[0];
+  v[k] = tc_jdot(u, v, 1, k, k) / k;
+}
+
+/* u v' = u': k u0 v_k = k u_k - sum_{j=1}^{k-1} j v_j u_{k-j}. */
+static inline void tc_log(real *v, const real *u, int k) {
+  if (k == 0) {
+    v[0] = LOG(u[0]);
+    return;
+  }
+  v[k] = (u[k] - tc_jdot(v, u, 1, k - 1, k) / k) / u[0];
 }
 
 /* The pair s, c with s' = c u' and c' = sign s u' (sin and cos: sign -1;
  * sinh and cosh: sign +1), at order k >= 1. */
-static inline void sicm_tc_pair(double *s, double *c, const double *u, int k, double sign) {
-  double a = 0, b = 0;
-  for (int j = 1; j <= k; ++j) {
-    a += j * u[j] * c[k - j];
-    b += j * u[j] * s[k - j];
-  }
+static inline void tc_pair(real *s, real *c, const real *u, int k, real sign) {
+  real a = tc_jdot(u, c, 1, k, k), b = tc_jdot(u, s, 1, k, k);
   s[k] = a / k;
   c[k] = sign * b / k;
 }
 
-static inline void sicm_tc_sincos(double *s, double *c, const double *u, int k) {
-  if (k == 0)
-    sincos(u[0], &s[0], &c[0]);
-  else
-    sicm_tc_pair(s, c, u, k, -1.0);
-}
-
-static inline void sicm_tc_sinhcosh(double *s, double *c, const double *u, int k) {
+static inline void tc_sincos(real *s, real *c, const real *u, int k) {
   if (k == 0) {
-    s[0] = sinh(u[0]);
-    c[0] = cosh(u[0]);
+    s[0] = SIN(u[0]);
+    c[0] = COS(u[0]);
   } else {
-    sicm_tc_pair(s, c, u, k, 1.0);
+    tc_pair(s, c, u, k, -1);
   }
 }
 
-/* v = atan2(y, x): r v' = x y' - y x' with r = x^2 + y^2 (kept in r). */
-static inline void sicm_tc_atan2(double *v, const double *y, const double *x, double *r, int k) {
-  r[k] = sicm_tc_product(x, x, k) + sicm_tc_product(y, y, k);
+static inline void tc_sinhcosh(real *s, real *c, const real *u, int k) {
   if (k == 0) {
-    v[0] = atan2(y[0], x[0]);
+    s[0] = SINH(u[0]);
+    c[0] = COSH(u[0]);
+  } else {
+    tc_pair(s, c, u, k, 1);
+  }
+}
+
+/* v = atan2(y, x): r v' = x y' - y x' with r = x^2 + y^2 (kept in r):
+ * k r0 v_k = sum_{j=0}^{k-1} (k - j) (x_j y_{k-j} - y_j x_{k-j})
+ *            - sum_{j=1}^{k-1} (k - j) r_j v_{k-j}. */
+static inline void tc_atan2(real *v, const real *y, const real *x, real *r, int k) {
+  r[k] = tc_square(x, k) + tc_square(y, k);
+  if (k == 0) {
+    v[0] = ATAN2(y[0], x[0]);
     return;
   }
-  double d = 0;
-  for (int j = 0; j < k; ++j) d += (k - j) * (x[j] * y[k - j] - y[j] * x[k - j]);
-  for (int j = 1; j < k; ++j) d -= r[j] * (k - j) * v[k - j];
+  /* with i = k - j: sum_{i=1}^{k} i (x_{k-i} y_i - y_{k-i} x_i), and
+   * sum_{i=1}^{k-1} i v_i r_{k-i} */
+  real d = tc_jdot(y, x, 1, k, k) - tc_jdot(x, y, 1, k, k) - tc_jdot(v, r, 1, k - 1, k);
   v[k] = d / (k * r[0]);
 }
-
+#undef SICM_TC_POWER_WEIGHT
+#undef SICM_TC_J
+#undef SICM_TC_ONE
+#undef SICM_TC_DOT
 )";
+
+namespace {
+
+// kTaylorSupport with its names made those of one precision: `real`, the
+// tc_ prefix and the math functions (POW, SQRT, ...).
+std::string instantiate(TaylorPrecision precision) {
+  const bool extended = precision == TaylorPrecision::Extended;
+  const std::pair<const char *, const char *> names[] = {
+      {"real", extended ? "long double" : "double"},
+      {"tc_", extended ? "sicm_tcl_" : "sicm_tc_"},
+      {"SICM_TC_", extended ? "SICM_TCL_" : "SICM_TC_"},
+      {"POW", extended ? "powl" : "pow"},
+      {"SQRT", extended ? "sqrtl" : "sqrt"},
+      {"EXP", extended ? "expl" : "exp"},
+      {"LOG", extended ? "logl" : "log"},
+      {"SINH", extended ? "sinhl" : "sinh"},
+      {"COSH", extended ? "coshl" : "cosh"},
+      {"SIN", extended ? "sinl" : "sin"},
+      {"COS", extended ? "cosl" : "cos"},
+      {"ATAN2", extended ? "atan2l" : "atan2"},
+  };
+  std::string out;
+  const std::string text = kTaylorSupport;
+  for (size_t i = 0; i < text.size();) {
+    bool replaced = false;
+    bool word_start =
+        i == 0 || !(std::isalnum(static_cast<unsigned char>(text[i - 1])) || text[i - 1] == '_');
+    for (const auto &[from, to] : names) {
+      size_t n = std::strlen(from);
+      bool prefix = from[std::strlen(from) - 1] == '_';
+      if (!word_start || text.compare(i, n, from) != 0) continue;
+      char next = i + n < text.size() ? text[i + n] : ' ';
+      if (!prefix && (std::isalnum(static_cast<unsigned char>(next)) || next == '_')) continue;
+      out += to;
+      i += n;
+      replaced = true;
+      break;
+    }
+    if (!replaced) out += text[i++];
+  }
+  return out;
+}
+
+} // namespace
+
+std::string c_taylor_support(TaylorPrecision precision) {
+  return std::string("/* Taylor-coefficient recurrences (sicm's Taylor emitter), in ") +
+         (precision == TaylorPrecision::Extended ? "long double" : "double") + ". */" +
+         instantiate(precision) + "\n";
 }
 
 } // namespace sicm

@@ -21,18 +21,32 @@
 // none here: the emitter then gives an empty string and says which.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "codegen/trace.hpp"
 
 namespace sicm {
 
-// The C function described above, or "" with a one-line reason in *why_not
-// when an operation of the trace has no recurrence here.
-std::string emit_taylor_function(const Trace &t, const std::string &c_name, std::string *why_not);
+// Double for taylor; long double for taylor-extended, whose function is
+//   void c_name(const long double *in, int order, long double *c, const double *p)
+// with every operation, constant ones too, computed in long double.
+enum class TaylorPrecision { Double, Extended };
 
-// The static inline helpers the Taylor functions call (the recurrences of
-// the elementary functions), once per translation unit.
-std::string c_taylor_support();
+// How a symbol of the trace that is not an input is written in C (a
+// run-time parameter of a built program: "p[2]"), or "" if it cannot be.
+using SymbolSpeller = std::function<std::string(Symbol *)>;
+
+// The C function described above, or "" with a one-line reason in *why_not
+// when an operation of the trace has no recurrence here or it holds a
+// symbol that is not an input and that spell does not spell.
+std::string emit_taylor_function(const Trace &t, const std::string &c_name, std::string *why_not,
+                                 TaylorPrecision precision = TaylorPrecision::Double,
+                                 const SymbolSpeller &spell = nullptr);
+
+// The static inline helpers the Taylor functions of one precision call
+// (the recurrences of the elementary functions), once per translation unit
+// and precision.
+std::string c_taylor_support(TaylorPrecision precision = TaylorPrecision::Double);
 
 } // namespace sicm

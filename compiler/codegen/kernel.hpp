@@ -41,6 +41,8 @@ namespace sicm {
 
 using KernelFn = void (*)(const double *in, double *out, const double *p);
 using TaylorFn = void (*)(const double *in, int order, double *c, const double *p);
+using TaylorExtendedFn = void (*)(const long double *in, int order, long double *c,
+                                  const double *p);
 
 // Allocated with gc_new (it holds Values); its strings are freed by a
 // finalizer when it is collected. The loaded code is never unloaded.
@@ -59,10 +61,11 @@ struct Kernel {
   KernelFn singular_factors = nullptr;
   std::vector<std::string> singular_texts;
   // For a system derivative compiled with `taylor`: the Taylor coefficients
-  // of its solution (codegen/emit_taylor.hpp), for sicm_ode_step_taylor;
-  // null, with the reason in taylor_why_not, when an operation has no
-  // recurrence.
+  // of its solution (codegen/emit_taylor.hpp), for sicm_ode_step_taylor,
+  // and the same in long double for sicm_ode_step_taylor_extended; null,
+  // with the reason in taylor_why_not, when an operation has no recurrence.
   TaylorFn taylor = nullptr;
+  TaylorExtendedFn taylor_extended = nullptr;
   std::string taylor_why_not;
 };
 
@@ -71,7 +74,7 @@ struct Kernel {
 struct KernelOptions {
   // Its singular factors, named by their place in the state ((ref state 1 0)).
   bool probe_singularities = false;
-  // The Taylor coefficient function of its solution.
+  // The Taylor coefficient functions of its solution (double and long double).
   bool taylor = false;
 };
 

@@ -267,22 +267,30 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
       source += emit_kernel_function(probe, probe_name, false);
     }
   }
+  // The Taylor coefficients in both precisions (taylor, taylor-extended).
   std::string taylor_name = c_name + "_taylor", taylor_why_not;
+  std::string extended_name = c_name + "_taylor_extended";
   bool has_taylor = false;
   if (options.taylor && list_length(sample_args) != 1)
     taylor_why_not = "it is not a system derivative (a procedure of one state)";
   if (options.taylor && list_length(sample_args) == 1) {
     std::string taylor = emit_taylor_function(t, taylor_name, &taylor_why_not);
-    has_taylor = !taylor.empty();
+    std::string extended =
+        emit_taylor_function(t, extended_name, &taylor_why_not, TaylorPrecision::Extended);
+    has_taylor = !taylor.empty() && !extended.empty();
     if (has_taylor)
-      source += "\n" + c_taylor_support() + "void " + taylor_name +
-                "(const double *in, int order, double *c, const double *p);\n\n" + taylor;
+      source += "\n" + c_taylor_support() + c_taylor_support(TaylorPrecision::Extended) + "void " +
+                taylor_name + "(const double *in, int order, double *c, const double *p);\n" +
+                "void " + extended_name +
+                "(const long double *in, int order, long double *c, const double *p);\n\n" +
+                taylor + "\n" + extended;
   }
   std::string so;
   void *fn = jit_load(source, c_name, &so, why_not);
   if (!fn) return nullptr;
   void *probe_fn = factors.values.empty() ? nullptr : jit_load(source, probe_name, &so, why_not);
   void *taylor_fn = has_taylor ? jit_load(source, taylor_name, &so, why_not) : nullptr;
+  void *extended_fn = has_taylor ? jit_load(source, extended_name, &so, why_not) : nullptr;
   Kernel *k = gc_new<Kernel>();
   // ignore_self: a std::string member may point into the object (its short-string buffer).
   GC_register_finalizer_ignore_self(k, finalize_kernel, nullptr, nullptr, nullptr);
@@ -298,6 +306,7 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   k->singular_factors = reinterpret_cast<KernelFn>(probe_fn);
   if (probe_fn) k->singular_texts = std::move(factors.texts);
   k->taylor = reinterpret_cast<TaylorFn>(taylor_fn);
+  k->taylor_extended = reinterpret_cast<TaylorExtendedFn>(extended_fn);
   k->taylor_why_not = std::move(taylor_why_not);
   if (!agrees_at_sample(k, proc, sample_args, why_not)) return nullptr;
   if (g_kernel_listener) g_kernel_listener(k);

@@ -476,6 +476,7 @@ const IntegratorName kIntegrators[] = {
     {"yoshida8", &sicm_ode_step_yoshida8, "sicm_ode_step_yoshida8"},
     // Taylor series from coefficients generated from the compiled derivative.
     {"taylor", &sicm_ode_step_taylor, "sicm_ode_step_taylor"},
+    {"taylor-extended", &sicm_ode_step_taylor_extended, "sicm_ode_step_taylor_extended"},
 };
 
 const IntegratorName *find_integrator(const std::string &name) {
@@ -499,7 +500,8 @@ const sicm_ode_step_type *arg_integrator(Value *a, int n, int i, const char *who
       runtime_error(current_call_loc(),
                     std::string(who) + ": *ode-integration-method* is " + write_string(m) +
                         ", which names no integrator (bulirsch-stoer, rk8pd, rkf45, rkck, msbdf, "
-                        "cvode-adams, cvode-bdf, verlet, yoshida4, yoshida6, yoshida8, taylor)");
+                        "cvode-adams, cvode-bdf, verlet, yoshida4, yoshida6, yoshida8, taylor, "
+                        "taylor-extended)");
     return T;
   }
   const sicm_ode_step_type *T = is_symbol(a[i]) ? integrator_for(symbol_name(a[i])) : nullptr;
@@ -613,7 +615,7 @@ struct OdeProblem {
       sicm_ode_set_singularity_probe(ode.get(), cb.kernel->singular_factors, nullptr,
                                      probe_texts.size(), probe_texts.data());
     }
-    if (T == sicm_ode_step_taylor) use_taylor(ode.get());
+    if (T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended) use_taylor(ode.get(), T);
     // Implicit methods solve with the Jacobian: from a kernel of (D sysder)
     // when the derivative itself compiled, else by finite differences.
     if ((T == sicm_ode_step_msbdf || T == sicm_ode_step_cvode_bdf) && cb.kernel) {
@@ -626,13 +628,16 @@ struct OdeProblem {
   // The taylor method takes its coefficients from the compiled derivative,
   // compiled again with them if it was compiled without; errors at the
   // call site when there are none.
-  void use_taylor(sicm_ode *ode) {
+  void use_taylor(sicm_ode *ode, const sicm_ode_step_type *T) {
     if (cb.kernel && !cb.kernel->taylor) {
       const Kernel *k = auto_kernel(cb.sysder, shape.build(y.data()), shape.dim(), true);
       if (k) cb.kernel = k;
     }
     if (cb.kernel && cb.kernel->taylor) {
-      sicm_ode_set_taylor(ode, cb.kernel->taylor, nullptr);
+      if (T == sicm_ode_step_taylor_extended)
+        sicm_ode_set_taylor_extended(ode, cb.kernel->taylor_extended, nullptr);
+      else
+        sicm_ode_set_taylor(ode, cb.kernel->taylor, nullptr);
       return;
     }
     std::string why =
@@ -641,18 +646,19 @@ struct OdeProblem {
         : cb.kernel->taylor_why_not.empty() ? "this one was compiled without them"
                                             : "this one has " + cb.kernel->taylor_why_not;
     numeric_error(cb.loc, cb.who,
-                  "taylor needs a compiled system derivative whose operations all have Taylor "
-                  "recurrences; " +
+                  std::string(sicm_ode_step_type_name(T)) +
+                      " needs a compiled system derivative whose operations all have Taylor "
+                      "recurrences; " +
                       why);
   }
 
   // For sicm bench: this integration, from the current state over [t0, t1].
   void record_site(const char *who, double t1, double eps, const sicm_ode_step_type *T) {
     if (!recording_integration_sites()) return;
-    record_integration_site(
-        IntegrationSite{loc_text(cb.loc), who, cb.kernel ? cb.kernel->fn : nullptr,
-                        cb.kernel ? cb.kernel->taylor : nullptr, y, shape.time_first(), t0, t1, eps,
-                        sicm_ode_step_type_name(T)});
+    record_integration_site(IntegrationSite{
+        loc_text(cb.loc), who, cb.kernel ? cb.kernel->fn : nullptr,
+        cb.kernel ? cb.kernel->taylor : nullptr, cb.kernel ? cb.kernel->taylor_extended : nullptr,
+        y, shape.time_first(), t0, t1, eps, sicm_ode_step_type_name(T)});
   }
 
   // Advance the integrator to t1; errors at the call site on failure.
@@ -712,7 +718,8 @@ Value advance_state(NativeProc *self, Value *a, int n) {
   double eps = arg_tolerance(a, n, 2, kAdvancerTolerance, who);
   const sicm_ode_step_type *T = arg_integrator(a, n, 3, who);
   OdeProblem p(loc, who, self->a, a[0], 1,
-               T == sicm_ode_step_taylor || recording_integration_sites());
+               T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended ||
+                   recording_integration_sites());
   double t = p.t0, t1 = p.t0 + dt;
   p.record_site(who, t1, eps, T);
   {
@@ -774,7 +781,8 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   double eps = arg_tolerance(a, n, 4, kAdvancerTolerance, who);
   const sicm_ode_step_type *T = arg_integrator(a, n, 5, who);
   OdeProblem p(loc, who, self->a, a[0], 1,
-               T == sicm_ode_step_taylor || recording_integration_sites());
+               T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended ||
+                   recording_integration_sites());
   if (dt == 0 && t_final != p.t0) bad_range(a[2], 3, who);
   p.record_site(who, t_final, eps, T);
   const double step = std::fabs(dt) * (t_final >= p.t0 ? 1.0 : -1.0);

@@ -418,6 +418,7 @@ const sicm_ode_step_type *const sicm_ode_step_bs = &sicm_ode_bs_type;
 const sicm_ode_step_type *const sicm_ode_step_cvode_adams = &sicm_ode_cvode_adams_type;
 const sicm_ode_step_type *const sicm_ode_step_cvode_bdf = &sicm_ode_cvode_bdf_type;
 const sicm_ode_step_type *const sicm_ode_step_taylor = &sicm_ode_taylor_type;
+const sicm_ode_step_type *const sicm_ode_step_taylor_extended = &sicm_ode_taylor_extended_type;
 
 /* ---- the public driver ------------------------------------------------ */
 
@@ -593,6 +594,14 @@ int sicm_ode_set_singularity_probe(sicm_ode *o, sicm_ode_probe probe, const doub
 int sicm_ode_set_taylor(sicm_ode *o, sicm_ode_taylor_coefficients coefficients,
                         const double *params) {
   o->taylor = coefficients;
+  o->taylor_params = params;
+  sicm_ode_reset(o);
+  return SICM_SUCCESS;
+}
+
+int sicm_ode_set_taylor_extended(sicm_ode *o, sicm_ode_taylor_extended_coefficients coefficients,
+                                 const double *params) {
+  o->taylor_extended = coefficients;
   o->taylor_params = params;
   sicm_ode_reset(o);
   return SICM_SUCCESS;

@@ -78,6 +78,7 @@ struct sicm_ode {
 
   /* sicm_ode_set_taylor: the Taylor coefficients of the solution (NULL: none). */
   sicm_ode_taylor_coefficients taylor;
+  sicm_ode_taylor_extended_coefficients taylor_extended; /* the same in long double */
   const double *taylor_params;
 
   int horizon_set; /* sicm_ode_set_horizon: where the caller is going */
@@ -150,5 +151,6 @@ extern const sicm_ode_step_type sicm_ode_bs_type;
 extern const sicm_ode_step_type sicm_ode_cvode_adams_type;
 extern const sicm_ode_step_type sicm_ode_cvode_bdf_type;
 extern const sicm_ode_step_type sicm_ode_taylor_type;
+extern const sicm_ode_step_type sicm_ode_taylor_extended_type;
 
 #endif /* SICM_ODE_INTERNAL_H */

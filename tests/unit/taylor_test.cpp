@@ -144,6 +144,61 @@ TEST(TaylorEmitter, AtanOfOneAndTwoArguments) {
   expect_series(series(k, {0, 0, 0}, 2), half_t_squared);
 }
 
+// (expt (sqrt u) a) is one power recurrence of u at a/2 (the Kepler
+// problem's r^-3): the series of (1 + t)^(-3/2).
+TEST(TaylorEmitter, PowerOfARoot) {
+  const Kernel *k = taylor_kernel("(up 1 (expt (sqrt (+ 1 t)) -3) 0)");
+  ASSERT_NE(k->taylor, nullptr) << k->taylor_why_not;
+  EXPECT_EQ(k->c_source.find("sicm_tc_sqrt(v"), std::string::npos) << "no square root left";
+  expect_series(series(k, {0, 0, 0}, 1), integral(binomial(-1.5)));
+}
+
+// ---- taylor-extended: the same recurrences in long double ----
+
+std::vector<long double> series_extended(const Kernel *k, std::vector<long double> state,
+                                         size_t i) {
+  std::vector<long double> c((kOrder + 1) * state.size());
+  k->taylor_extended(state.data(), kOrder, c.data(), nullptr);
+  std::vector<long double> out;
+  for (int j = 0; j <= kOrder; ++j)
+    out.push_back(c[j * state.size() + i]);
+  return out;
+}
+
+// Agreement to a few roundings of long double (5.4e-20), far below double's.
+void expect_series_extended(const std::vector<long double> &got,
+                            const std::vector<long double> &want) {
+  ASSERT_EQ(got.size(), want.size());
+  for (size_t k = 0; k < got.size(); ++k)
+    EXPECT_LE(fabsl(got[k] - want[k]), 1e-18L * fmaxl(1.0L, fabsl(want[k])))
+        << "coefficient " << k << ": " << (double)got[k] << " vs " << (double)want[k];
+}
+
+TEST(TaylorEmitter, ExtendedExpAndPowers) {
+  const Kernel *k = taylor_kernel("(up 1 (exp t) (expt (sqrt (+ 1 t)) -3))");
+  ASSERT_NE(k->taylor_extended, nullptr) << k->taylor_why_not;
+  std::vector<long double> exp_series, power_series{0.0L};
+  long double term = 1, binomial_term = 1;
+  for (int j = 0; j <= kOrder; ++j) {
+    exp_series.push_back(term);
+    term /= j + 1;
+    if (j < kOrder) power_series.push_back(binomial_term / (j + 1)); // integral of (1+t)^-1.5
+    binomial_term *= (-1.5L - j) / (j + 1);
+  }
+  expect_series_extended(series_extended(k, {0, 1, 0}, 1), exp_series);
+  expect_series_extended(series_extended(k, {0, 1, 0}, 2), power_series);
+}
+
+// Exact constants are long double constants: 1/3 to long double's
+// rounding, not double's (1/3 as a double is off by 1.9e-17). (A flonum,
+// such as (sqrt 2) evaluated by the program, is the double it is.)
+TEST(TaylorEmitter, ExtendedConstants) {
+  const Kernel *k = taylor_kernel("(up 1 (* 1/3 (+ t 1)) 0)");
+  ASSERT_NE(k->taylor_extended, nullptr) << k->taylor_why_not;
+  std::vector<long double> third = series_extended(k, {0, 0, 0}, 1);
+  EXPECT_LE(fabsl(third[1] - 1.0L / 3), 1e-19L);
+}
+
 TEST(TaylorEmitter, OperationsWithoutRecurrencesAreNamed) {
   const Kernel *k = taylor_kernel("(up 1 (tan t) 0)");
   ASSERT_NE(k, nullptr);

@@ -67,7 +67,16 @@ typedef int (*sicm_ode_jacobian)(double t, const double *y, double *dfdy, double
  *                              tolerance; step from the sizes of the last two
  *                              coefficients. Explicit; no stiffness watch. One
  *                              Taylor expansion counts as one rhs evaluation in
- *                              the statistics (it costs a few). */
+ *                              the statistics (it costs a few). Steps run on to
+ *                              the horizon (sicm_ode_set_horizon) and a t1 inside
+ *                              a step is answered from its polynomial (dense
+ *                              output).
+ *   sicm_ode_step_taylor_extended  The same in long double (64-bit significand
+ *                              on x86), from a coefficient function in long
+ *                              double (sicm_ode_set_taylor_extended); its state
+ *                              stays in long double between calls that pass back
+ *                              the state they were given. For references and
+ *                              errors below double rounding over long runs. */
 typedef struct sicm_ode_step_type sicm_ode_step_type;
 
 extern const sicm_ode_step_type *const sicm_ode_step_rk8pd;
@@ -82,6 +91,7 @@ extern const sicm_ode_step_type *const sicm_ode_step_yoshida4;
 extern const sicm_ode_step_type *const sicm_ode_step_yoshida6;
 extern const sicm_ode_step_type *const sicm_ode_step_yoshida8;
 extern const sicm_ode_step_type *const sicm_ode_step_taylor;
+extern const sicm_ode_step_type *const sicm_ode_step_taylor_extended;
 
 /* sicm_ode_step_type_name returns the type's short name ("rk8pd", "bs",
  * "cvode-bdf", ...), as used in messages. */
@@ -217,6 +227,15 @@ typedef void (*sicm_ode_taylor_coefficients)(const double *y, int order, double 
                                              const double *params);
 int sicm_ode_set_taylor(sicm_ode *o, sicm_ode_taylor_coefficients coefficients,
                         const double *params);
+
+/* sicm_ode_set_taylor_extended gives sicm_ode_step_taylor_extended its
+ * coefficient function, as sicm_ode_set_taylor but in long double (params
+ * stay double: they are the program's run-time values). Returns
+ * SICM_SUCCESS. */
+typedef void (*sicm_ode_taylor_extended_coefficients)(const long double *y, int order,
+                                                      long double *c, const double *params);
+int sicm_ode_set_taylor_extended(sicm_ode *o, sicm_ode_taylor_extended_coefficients coefficients,
+                                 const double *params);
 
 /* sicm_ode_set_horizon tells the integrator that the caller will go on
  * calling sicm_ode_evolve towards t_end (a loop that stops every dt to

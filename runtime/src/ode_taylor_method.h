@@ -1,0 +1,205 @@
+/* The Taylor method written once over a floating type, for ode_taylor.c to
+ * instantiate in double (taylor) and long double (taylor-extended).
+ *
+ * Before including, define:
+ *   REAL          the type of the state and the coefficients
+ *   NAME(x)       x with this precision's prefix (taylor_x, taylor_ext_x)
+ *   COEFFICIENTS  an expression of o: the coefficient function, or NULL
+ *   FABS          fabs or fabsl
+ *   TAYLOR_METHOD_NAME, SET_COEFFICIENTS  the method's and its setter's names, for messages
+ * It defines NAME(init), NAME(evolve), NAME(reset), NAME(free) for a step
+ * type table, and undefines nothing (ode_taylor.c does).
+ *
+ * The method keeps its own copy of the state, in REAL, at its own time,
+ * which may be ahead of the caller (dense output): a step is as long as the
+ * series allows, up to the horizon the caller set (sicm_ode_set_horizon) or
+ * else up to t1, and the caller's t1 inside the step in hand is answered by
+ * evaluating that step's polynomial there. A caller who comes back with the
+ * state it was given continues from the method's own state, so neither the
+ * stops of a monitor loop nor the rounding to double of the extended state
+ * shorten a step or lose accuracy; any other state starts afresh. */
+
+typedef struct {
+  int order;
+  REAL *c;    /* (order + 1) * dim: the expansion at the start of the step in hand */
+  REAL *y;    /* the method's own state, at time t */
+  REAL *comp; /* its rounding error, carried (compensated summation) */
+  REAL t;
+  REAL t0;       /* the step in hand covers [t0, t] (have_step) */
+  int have_step; /* c holds the expansion at t0 */
+  int synced;    /* y, t valid and t_out, y_out what the caller was given */
+  double t_out;
+  double *y_out;
+} NAME(state);
+
+static int NAME(init)(sicm_ode *o) {
+  NAME(state) *s = calloc(1, sizeof *s);
+  if (!s) return SICM_ENOMEM;
+  o->backend = s;
+  s->order = taylor_order(o);
+  s->c = malloc((size_t)(s->order + 1) * o->dim * sizeof *s->c);
+  s->y = malloc(o->dim * sizeof *s->y);
+  s->comp = malloc(o->dim * sizeof *s->comp);
+  s->y_out = malloc(o->dim * sizeof *s->y_out);
+  return s->c && s->y && s->comp && s->y_out ? SICM_SUCCESS : SICM_ENOMEM;
+}
+
+static void NAME(reset)(sicm_ode *o) {
+  NAME(state) *s = o->backend;
+  s->synced = 0;
+  s->have_step = 0;
+}
+
+static void NAME(free)(sicm_ode *o) {
+  NAME(state) *s = o->backend;
+  free(s->c);
+  free(s->y);
+  free(s->comp);
+  free(s->y_out);
+  free(s);
+}
+
+/* The step size the coefficients allow (positive; INFINITY when the series
+ * ends before order p - 1, as for a polynomial solution): Jorba and Zou's
+ * h = min over k = p-1, p of rho_k^(-1/k), times exp(-0.7/(p-1)), where
+ * rho_k = max_i |c_k,i| / (abs_tol + rel_tol |y_i|). */
+static double NAME(step_for)(const sicm_ode *o, const NAME(state) * s) {
+  const int p = s->order;
+  double h = INFINITY;
+  for (int k = p - 1; k <= p; k++) {
+    const REAL *ck = s->c + (size_t)k * o->dim;
+    double rho = 0;
+    for (size_t i = 0; i < o->dim; i++)
+      rho = fmax(rho, (double)(FABS(ck[i]) / (o->abs_tol + o->rel_tol * FABS(s->y[i]))));
+    if (rho > 0) h = fmin(h, pow(rho, -1.0 / k));
+  }
+  return h * exp(-0.7 / (p - 1));
+}
+
+static int NAME(finite)(size_t n, const REAL *v) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i])) return 0;
+  return 1;
+}
+
+/* The caller's view of the method's own state. */
+static void NAME(report)(const sicm_ode *o, const NAME(state) * s, double *t, double *y) {
+  for (size_t i = 0; i < o->dim; i++)
+    y[i] = (double)s->y[i];
+  *t = (double)s->t;
+}
+
+/* One step from the own state (t, y) towards `limit`: expand, choose h,
+ * advance. Returns SICM_SUCCESS or a failure (reported at the own state). */
+static int NAME(step)(sicm_ode *o, NAME(state) * s, REAL limit, double *t, double *y) {
+  const size_t dim = o->dim;
+  const int p = s->order;
+  s->have_step = 0;
+  COEFFICIENTS(s->y, p, s->c, o->taylor_params);
+  o->stats.rhs_evals++;
+  if (!NAME(finite)((size_t)(p + 1) * dim, s->c)) {
+    NAME(report)(o, s, t, y);
+    return sicm_ode_fail(o, SICM_EBADFUNC, *t, y, "non-finite derivative",
+                         "the Taylor coefficients of the solution are NaN or infinite here");
+  }
+  const REAL dir = limit > s->t ? 1 : -1;
+  REAL h = dir * NAME(step_for)(o, s);
+  const int final = FABS(h) >= FABS(limit - s->t);
+  if (final)
+    h = limit - s->t;
+  else
+    o->h = (double)h;
+  /* The step the time will actually take: t + h rounds, and a state
+   * advanced by the unrounded h would drift in phase from its time by an
+   * ulp of t a step (3e-14 over ten periods of an oscillator). */
+  if (!final) h = (s->t + h) - s->t;
+  if (s->t + h == s->t) {
+    char detail[160];
+    snprintf(detail, sizeof detail,
+             "the series allows only h = %.3g, below the resolution of t; the solution may be "
+             "singular here",
+             (double)FABS(h));
+    NAME(report)(o, s, t, y);
+    return sicm_ode_fail(o, SICM_ESTEP, *t, y, "step size too small", detail);
+  }
+  /* y += sum_{k>=1} c_k h^k by Horner, the increment added with Kahan's
+   * compensation carried from step to step: the rounding of y, a few ulps
+   * a step, would otherwise accumulate over the many steps of a long run. */
+  for (size_t i = 0; i < dim; i++) {
+    REAL v = s->c[(size_t)p * dim + i];
+    for (int k = p - 1; k >= 1; k--)
+      v = v * h + s->c[(size_t)k * dim + i];
+    const REAL increment = v * h + s->comp[i];
+    const REAL sum = s->y[i] + increment;
+    s->comp[i] = (s->y[i] - sum) + increment;
+    s->y[i] = sum;
+  }
+  if (!NAME(finite)(dim, s->y)) {
+    for (size_t i = 0; i < dim; i++) /* back to the last accepted point */
+      s->y[i] = s->c[i];
+    NAME(report)(o, s, t, y);
+    return sicm_ode_fail(o, SICM_EBADFUNC, *t, y, "non-finite state",
+                         "a Taylor step gave NaN or infinite components");
+  }
+  s->t0 = s->t;
+  s->t = final ? limit : s->t + h;
+  s->have_step = 1;
+  o->stats.steps++;
+  return SICM_SUCCESS;
+}
+
+static int NAME(evolve)(sicm_ode *o, double *t, double t1, double *y) {
+  NAME(state) *s = o->backend;
+  const size_t dim = o->dim;
+  if (!COEFFICIENTS)
+    return sicm_ode_fail(o, SICM_EINVAL, *t, y, "no Taylor coefficients",
+                         "the " TAYLOR_METHOD_NAME
+                         " method needs a coefficient function (" SET_COEFFICIENTS
+                         "), which the compiler makes from a compiled system derivative");
+  if (!s->synced || *t != s->t_out || memcmp(y, s->y_out, dim * sizeof *y) != 0) {
+    for (size_t i = 0; i < dim; i++) {
+      s->y[i] = y[i];
+      s->comp[i] = 0;
+    }
+    s->t = *t;
+    s->have_step = 0;
+    s->synced = 1;
+  }
+  const double dir = t1 > *t ? 1.0 : -1.0;
+  /* Steps may run on to the horizon, never past it nor back from it. */
+  REAL limit = t1;
+  if (o->horizon_set && (o->horizon - t1) * dir > 0) limit = o->horizon;
+  unsigned long steps = 0;
+  for (;;) {
+    if (s->t == (REAL)t1) {
+      NAME(report)(o, s, t, y);
+      break;
+    }
+    if (s->have_step && (t1 - s->t0) * dir >= 0 && (s->t - t1) * dir > 0) {
+      /* t1 inside the step in hand: its polynomial there. */
+      const REAL tau = (REAL)t1 - s->t0;
+      const int p = s->order;
+      for (size_t i = 0; i < dim; i++) {
+        REAL v = s->c[(size_t)p * dim + i];
+        for (int k = p - 1; k >= 0; k--)
+          v = v * tau + s->c[(size_t)k * dim + i];
+        y[i] = (double)v;
+      }
+      break;
+    }
+    if (steps++ >= o->max_steps) {
+      NAME(report)(o, s, t, y);
+      s->synced = 0;
+      return sicm_ode_fail_max_steps(o, *t, y);
+    }
+    int status = NAME(step)(o, s, limit, t, y);
+    if (status != SICM_SUCCESS) {
+      s->synced = 0;
+      return status;
+    }
+  }
+  *t = t1;
+  s->t_out = t1;
+  memcpy(s->y_out, y, dim * sizeof *y);
+  return SICM_SUCCESS;
+}
