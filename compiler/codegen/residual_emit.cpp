@@ -25,6 +25,7 @@
 
 #include "algebra/linear_solve.hpp"
 #include "codegen/emit_c.hpp"
+#include "codegen/emit_taylor.hpp"
 #include "syntax/error.hpp"
 
 namespace sicm {
@@ -94,7 +95,11 @@ public:
     for (size_t f = 1; f < p_.functions.size(); ++f)
       out += "static void f" + std::to_string(f) +
              "(const double *in, double *out, const double *p);\n";
+    out += taylor_prototypes_;
     out += "\n" + functions;
+    if (!taylor_code_.empty()) out += c_taylor_support() + taylor_code_;
+    if (!taylor_extended_code_.empty())
+      out += c_taylor_support(TaylorPrecision::Extended) + taylor_extended_code_;
     out += "static const char *const parameters[] = {";
     for (const std::string &name : p_.parameters)
       out += c_string_literal(name) + ", ";
@@ -313,10 +318,47 @@ private:
   }
 
   std::string ode(const RStmt &s, size_t dim) {
+    std::string taylor = "NULL", extended = "NULL";
+    if (s.method == "sicm_ode_step_taylor") taylor = taylor_function(s.callee, false);
+    if (s.method == "sicm_ode_step_taylor_extended") extended = taylor_function(s.callee, true);
     return "(sicm_drive_ode){" + s.method + ", " + closure(s.callee) + ", " + std::to_string(dim) +
            ", " + (s.time_first ? "1" : "0") + ", " + (s.rate_one ? "1" : "0") + ", " +
            c_double_literal(s.number) + ", " + closure(s.jacobian) + ", " + closure(s.probe) +
-           ", " + std::to_string(s.probe_texts.size()) + ", " + probe_texts(s.probe_texts) + "}";
+           ", " + std::to_string(s.probe_texts.size()) + ", " + probe_texts(s.probe_texts) + ", " +
+           taylor + ", " + extended + "}";
+  }
+
+  // The Taylor coefficient function of system derivative f (fN_taylor or
+  // fN_taylor_extended), generated once; its captures are read from p[] as
+  // f reads them. builtins_build.cpp checked that it can be generated.
+  std::string taylor_function(int f, bool extended) {
+    std::string name = "f" + std::to_string(f) + (extended ? "_taylor_extended" : "_taylor");
+    if (!taylor_names_.insert(name).second) return name;
+    const RFunction &fn = p_.functions[f];
+    Trace t;
+    for (int v : fn.inputs)
+      t.inputs.push_back(p_.vars[v].sym);
+    t.outputs = fn.outputs;
+    std::map<Symbol *, std::string> captured;
+    size_t k = 0;
+    for (int v : captures_[f])
+      captured[p_.vars[v].sym] = "p[" + std::to_string(k++) + "]";
+    std::string why_not;
+    std::string code = emit_taylor_function(
+        t, name, &why_not, extended ? TaylorPrecision::Extended : TaylorPrecision::Double,
+        [&](Symbol *s) {
+          auto it = captured.find(s);
+          return it == captured.end() ? std::string() : it->second;
+        });
+    if (code.empty()) internal_failure(__FILE__, __LINE__, ("taylor: " + why_not).c_str());
+    (extended ? taylor_extended_code_ : taylor_code_) += code + "\n";
+    taylor_prototypes_ += extended ? "void " + name +
+                                         "(const long double *in, int order, long double *c, "
+                                         "const double *p);\n"
+                                   : "void " + name +
+                                         "(const double *in, int order, double *c, const double "
+                                         "*p);\n";
+    return name;
   }
 
   // The used outputs of a statement from an array: declared here, or assigned
@@ -617,6 +659,8 @@ private:
   std::string sites_;
   int nsites_ = 0;
   int nprobes_ = 0;
+  std::set<std::string> taylor_names_;
+  std::string taylor_prototypes_, taylor_code_, taylor_extended_code_;
 };
 
 } // namespace

@@ -47,6 +47,7 @@
 #include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
+#include "codegen/emit_taylor.hpp"
 #include "codegen/kernel_form.hpp"
 #include "codegen/singular_factors.hpp"
 #include "codegen/state_shape.hpp"
@@ -857,11 +858,6 @@ std::string method_of(Value *a, int n, int i, const char *who) {
     runtime_error(here(), std::string(who) + ": *ode-integration-method* is " + write_string(m) +
                               ", which names no integrator");
   }
-  // Its coefficient function is generated for sicm run's kernels only.
-  if (std::string_view(c) == "sicm_ode_step_taylor")
-    cannot_compile(here(), std::string(who) +
-                               ": the taylor method is not available in sicm build yet (it "
-                               "is in sicm run); choose another integrator");
   return c;
 }
 
@@ -914,6 +910,32 @@ void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
   ExprId d0 = current().outputs[0];
   s.rate_one =
       expr_is_exact_one(d0) || (expr_kind(d0) == ExprKind::Flonum && expr_node(d0).d == 1.0);
+}
+
+// The taylor methods integrate with the Taylor coefficients of the
+// solution, which residual_emit generates from the traced derivative: it
+// must be one DAG of operations with recurrences, without statements (a
+// test of a run-time value, a cell read) in its body.
+void check_taylor(const RStmt &s, const char *who) {
+  if (s.method != "sicm_ode_step_taylor" && s.method != "sicm_ode_step_taylor_extended") return;
+  const char *method = s.method == "sicm_ode_step_taylor" ? "taylor" : "taylor-extended";
+  const RFunction &f = g_prog->functions[s.callee];
+  if (!f.body.empty())
+    cannot_compile(s.loc, std::string(who) + ": " + method +
+                               " needs a system derivative that is one expression of the state; "
+                               "this one tests or reads run-time values; choose another "
+                               "integrator");
+  Trace t;
+  for (int v : f.inputs)
+    t.inputs.push_back(g_prog->vars[v].sym);
+  t.outputs = f.outputs;
+  std::string why_not;
+  auto any_symbol = [](Symbol *) { return std::string("p[0]"); };
+  if (emit_taylor_function(t, "check", &why_not, TaylorPrecision::Double, any_symbol).empty())
+    cannot_compile(s.loc, std::string(who) + ": " + method +
+                              " needs a compiled system derivative whose operations all have "
+                              "Taylor recurrences; this one has " +
+                              why_not);
 }
 
 // What the system derivative divides by, as a function of its own inputs
@@ -1011,6 +1033,7 @@ Value advance(NativeProc *self, Value *a, int n) {
   state_args(a[0], s, who);
   s.args.push_back(expr_of(a[1], who));
   trace_system(self->a, a[0], s, who);
+  check_taylor(s, who);
   trace_singular_factors(a[0], s);
   trace_jacobian(self->a, a[0], s);
   Value r = state_result(a[0], s);
@@ -1034,6 +1057,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   s.args.push_back(expr_of(a[2], who));
   s.args.push_back(expr_of(a[3], who));
   trace_system(self->a, a[0], s, who);
+  check_taylor(s, who);
   trace_singular_factors(a[0], s);
   trace_jacobian(self->a, a[0], s);
   Value monitor = a[1];

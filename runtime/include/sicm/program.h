@@ -132,6 +132,11 @@ typedef struct {
   sicm_closure probe;
   size_t probe_count;
   const char *const *probe_texts;
+  /* For the taylor methods: the Taylor coefficients of the solution, in
+   * double (taylor) or long double (taylor-extended), generated from
+   * sysder's code and given sysder's p; NULL otherwise. */
+  sicm_ode_taylor_coefficients taylor;
+  sicm_ode_taylor_extended_coefficients taylor_extended;
 } sicm_drive_ode;
 
 /* ((state-advancer ...) state dt tol): y (dim leaves) becomes the state dt
