@@ -30,9 +30,13 @@
 // recurrence, which needs the base nonzero, as the derivative of the power
 // does.
 //
-// Limits: tan, asin, acos, variable exponents and linear solves have no
-// recurrence here (see emit_taylor.hpp); the caller says so and integrates
-// another way.
+// A linear solve x = M^-1 b (the mass matrix of a chain) is M x = b order
+// by order: M_0 x_k = b_k - sum_{j>=1} M_j x_{k-j}, with M_0 factored once
+// per expansion, so each order costs a matrix-vector convolution and two
+// triangular solves.
+//
+// Limits: tan, asin, acos and variable exponents have no recurrence here
+// (see emit_taylor.hpp); the caller says so and integrates another way.
 #include "codegen/emit_taylor.hpp"
 
 #include <algorithm>
@@ -192,12 +196,13 @@ private:
            std::to_string(input_.at(n.sym)) + "];");
       return true;
     }
+    if (array_of_.count(id)) return true; // a partner: sin/cos, sinh/cosh, a solve's components
     if (n.kind == ExprKind::Call) {
-      *why_not = is_solve_node(id) ? "a linear solve (a division by a matrix of the state)"
-                                   : "a call of an unknown function";
+      if (is_solve_node(id) && !is_interpreted_solve(id)) return emit_solve(id);
+      *why_not =
+          is_solve_node(id) ? "a linear solve outside a kernel" : "a call of an unknown function";
       return false;
     }
-    if (array_of_.count(id)) return true; // the partner of a sin/cos or sinh/cosh pair
     Op op = n.op;
     std::vector<ExprId> args = expr_arg_vector(id);
     std::string v = array("v");
@@ -273,6 +278,39 @@ private:
       acc = p;
     }
     line(v + "[k] = " + scale + product(acc, factors.back()) + ";");
+    return true;
+  }
+
+  // x = M^-1 b: all n components at once, by the solve recurrence, into
+  // arrays that the component nodes of the same M and b share.
+  bool emit_solve(ExprId id) {
+    const size_t n = solve_dimension(id);
+    std::string g = "g" + std::to_string(nsolves_++);
+    std::string entries, rhs, components;
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j)
+        entries += (entries.empty() ? "" : ", ") + coefficients(solve_matrix_entry(id, i, j));
+    for (size_t i = 0; i < n; ++i)
+      rhs += (rhs.empty() ? "" : ", ") + coefficients(solve_rhs_entry(id, i));
+    // The component nodes of this M and b: the solve's arguments with
+    // another component number.
+    std::vector<ExprId> args = expr_arg_vector(id);
+    for (size_t c = 0; c < n; ++c) {
+      args[0] = expr_integer(static_cast<int64_t>(c));
+      ExprId component = expr_call(expr_node(id).head, args.data(), args.size());
+      std::string x = array("x");
+      if (std::binary_search(nodes_.begin(), nodes_.end(), component)) array_of_[component] = x;
+      components += (components.empty() ? "" : ", ") + x;
+    }
+    const std::string size = std::to_string(n);
+    tables_ += "  const " + real_ + " *" + g + "_m[] = {" + entries + "};\n";
+    tables_ += "  const " + real_ + " *" + g + "_b[] = {" + rhs + "};\n";
+    tables_ += "  " + real_ + " *" + g + "_x[] = {" + components + "};\n";
+    tables_ +=
+        "  " + real_ + " " + g + "_lu[" + std::to_string(n * n) + "], " + g + "_r[" + size + "];\n";
+    tables_ += "  int " + g + "_pivots[" + size + "];\n";
+    line(tc_ + "solve(" + size + ", " + g + "_m, " + g + "_b, " + g + "_x, " + g + "_lu, " + g +
+         "_pivots, " + g + "_r, k);");
     return true;
   }
 
@@ -393,6 +431,7 @@ private:
     }
     for (const std::string &a : arrays_)
       f += "  " + real_ + " " + a + "[K];\n";
+    f += tables_;
     f += spread_inits_;
     f += "  for (int i = 0; i < " + std::to_string(n) + "; ++i) c[i] = in[i];\n";
     f += "  for (int k = 0; k < order; ++k) {\n" + body_ + outs + "  }\n}\n";
@@ -452,8 +491,8 @@ private:
   std::unordered_map<ExprId, std::string> array_of_, scalar_, spread_;
   std::vector<ExprId> constants_;
   std::vector<std::string> constant_names_, arrays_;
-  std::string body_, spread_inits_;
-  size_t narrays_ = 0;
+  std::string body_, spread_inits_, tables_;
+  size_t narrays_ = 0, nsolves_ = 0;
 };
 
 } // namespace
@@ -601,6 +640,49 @@ static inline void tc_atan2(real *v, const real *y, const real *x, real *r, int 
   real d = tc_jdot(y, x, 1, k, k) - tc_jdot(x, y, 1, k, k) - tc_jdot(v, r, 1, k - 1, k);
   v[k] = d / (k * r[0]);
 }
+/* x = M^-1 b for series M (n x n, row-major) and b, by M x = b order by
+ * order: M_0 x_k = b_k - sum_{j=1}^{k} M_j x_{k-j}. At k = 0, M_0 is
+ * factored (LU with partial pivoting) into lu and pivots, kept for the
+ * other orders; a singular M_0 gives NaN coefficients. */
+static inline void tc_solve(int n, const real *const *m, const real *const *b, real *const *x,
+                            real *lu, int *pivots, real *r, int k) {
+  if (k == 0) {
+    for (int i = 0; i < n * n; ++i) lu[i] = m[i][0];
+    for (int c = 0; c < n; ++c) {
+      int p = c;
+      for (int i = c + 1; i < n; ++i)
+        if (FABS(lu[i * n + c]) > FABS(lu[p * n + c])) p = i;
+      pivots[c] = p;
+      for (int j = 0; p != c && j < n; ++j) {
+        real t = lu[c * n + j];
+        lu[c * n + j] = lu[p * n + j];
+        lu[p * n + j] = t;
+      }
+      if (lu[c * n + c] == 0) lu[c * n + c] = NAN;
+      for (int i = c + 1; i < n; ++i) {
+        real f = lu[i * n + c] /= lu[c * n + c];
+        for (int j = c + 1; j < n; ++j) lu[i * n + j] -= f * lu[c * n + j];
+      }
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    real s = b[i][k];
+    for (int j = 0; j < n; ++j) s -= tc_dot(m[i * n + j], x[j], 1, k, k);
+    r[i] = s;
+  }
+  for (int c = 0; c < n; ++c) {
+    real t = r[c];
+    r[c] = r[pivots[c]];
+    r[pivots[c]] = t;
+  }
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < i; ++j) r[i] -= lu[i * n + j] * r[j];
+  for (int i = n - 1; i >= 0; --i) {
+    for (int j = i + 1; j < n; ++j) r[i] -= lu[i * n + j] * r[j];
+    r[i] /= lu[i * n + i];
+    x[i][k] = r[i];
+  }
+}
 #undef SICM_TC_POWER_WEIGHT
 #undef SICM_TC_J
 #undef SICM_TC_ONE
@@ -626,6 +708,7 @@ std::string instantiate(TaylorPrecision precision) {
       {"SIN", extended ? "sinl" : "sin"},
       {"COS", extended ? "cosl" : "cos"},
       {"ATAN2", extended ? "atan2l" : "atan2"},
+      {"FABS", extended ? "fabsl" : "fabs"},
   };
   std::string out;
   const std::string text = kTaylorSupport;

@@ -16,9 +16,10 @@
 //
 // Limits: operations with recurrences are + - * /, expt with a constant
 // exponent (integer or real), sqrt, exp, log, sin and cos, sinh and cosh,
-// atan (one and two arguments) and abs. tan, asin, acos, powers with a
-// variable exponent and linear solves (algebra/linear_solve.hpp) have
-// none here: the emitter then gives an empty string and says which.
+// atan (one and two arguments), abs and the linear solves of kernels
+// (algebra/linear_solve.hpp). tan, asin, acos and powers with a variable
+// exponent have none here: the emitter then gives an empty string and says
+// which.
 #pragma once
 
 #include <functional>

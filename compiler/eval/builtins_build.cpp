@@ -922,9 +922,9 @@ void check_taylor(const RStmt &s, const char *who) {
   const RFunction &f = g_prog->functions[s.callee];
   if (!f.body.empty())
     cannot_compile(s.loc, std::string(who) + ": " + method +
-                               " needs a system derivative that is one expression of the state; "
-                               "this one tests or reads run-time values; choose another "
-                               "integrator");
+                              " needs a system derivative that is one expression of the state; "
+                              "this one tests or reads run-time values; choose another "
+                              "integrator");
   Trace t;
   for (int v : f.inputs)
     t.inputs.push_back(g_prog->vars[v].sym);
