@@ -110,8 +110,9 @@ std::string short_number(double x) {
 // ---- the diagram -----------------------------------------------------------------------
 
 constexpr double kPanelWidth = 640, kPanelHeight = 420, kMargin = 60, kLegendWidth = 150;
-const char *const kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
-                               "#ff7f0e", "#8c564b", "#e377c2", "#17becf"};
+// One color per adaptive method (nine), so no two curves share one.
+const char *const kColors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e",
+                               "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
 
 std::string xml_escaped(const std::string &s) {
   std::string out;
