@@ -47,7 +47,7 @@ UNIT_SRCS     := $(wildcard tests/unit/*.cpp)
 # The standard library, embedded in the binary; listed in load order.
 STDLIB_FILES  := $(addprefix stdlib/,prelude.sicm local.sicm numerics.sicm lagrangian.sicm \
                    rigid-body.sicm hamiltonian.sicm maps.sicm stability.sicm canonical.sicm \
-                   lie.sicm)
+                   lie.sicm effects.sicm)
 STDLIB_GEN    := $(BUILD)/gen/stdlib_embed.cpp
 
 COMPILER_OBJS := $(COMPILER_SRCS:%.cpp=$(BUILD)/%.o) $(BUILD)/gen/stdlib_embed.o
@@ -60,7 +60,7 @@ SICM    := $(BUILD)/sicm
 RTLIB   := $(BUILD)/libsicmrt.a
 UNITBIN := $(BUILD)/unit-tests
 
-.PHONY: all check demo examples stability accuracy install clean deps unit fuzz-smoke
+.PHONY: all check demo examples stability accuracy effects install clean deps unit fuzz-smoke
 all: $(SICM) $(RTLIB)
 
 $(BUILD)/%.o: %.cpp
@@ -147,6 +147,11 @@ stability: deps
 accuracy: deps
 	@$(MAKE) --no-print-directory all
 	@bench/work-precision/run --sicm $(SICM)
+
+# What each effect of a scene costs: every subset built and timed, into docs/effects.md
+effects: deps
+	@$(MAKE) --no-print-directory all
+	@bench/effects/run --sicm $(SICM)
 
 # Every figure scene at full size, built with sicm build and run, into
 # $(BUILD)/figures (scripts/run-examples without --build interprets them).

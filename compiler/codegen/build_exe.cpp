@@ -19,6 +19,7 @@
 #include "codegen/residual_emit.hpp"
 #include "eval/build.hpp"
 #include "eval/core.hpp"
+#include "eval/effects_used.hpp"
 #include "eval/interp.hpp"
 #include "syntax/error.hpp"
 
@@ -116,13 +117,13 @@ int build_program(const BuildOptions &o) {
   if (!o.report_path.empty()) {
     std::vector<KernelReport> kernels = report_kernels(program, c);
     std::ofstream json(o.report_path, std::ios::binary);
-    json << report_json(kernels, {});
+    json << report_json(kernels, used_effects());
     if (!json) {
       std::fprintf(stderr, "sicm: error: cannot write %s\n", o.report_path.c_str());
       return kExitCantCreat;
     }
     if (o.report_only) {
-      std::fputs(report_table(kernels).c_str(), stdout);
+      std::fputs(report_table(kernels, used_effects()).c_str(), stdout);
       std::printf("wrote %s\n", o.report_path.c_str());
       return 0;
     }

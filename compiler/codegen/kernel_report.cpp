@@ -265,7 +265,8 @@ std::string report_json(const std::vector<KernelReport> &kernels,
   return s + "]}\n";
 }
 
-std::string report_table(const std::vector<KernelReport> &kernels) {
+std::string report_table(const std::vector<KernelReport> &kernels,
+                         const std::vector<std::string> &effects) {
   std::string s;
   char line[512];
   std::snprintf(line, sizeof line,
@@ -289,6 +290,12 @@ std::string report_table(const std::vector<KernelReport> &kernels) {
         s += " " + p;
       s += "\n";
     }
+  }
+  if (!effects.empty()) {
+    s += "effects:";
+    for (const std::string &e : effects)
+      s += " " + e;
+    s += "\n";
   }
   return s;
 }

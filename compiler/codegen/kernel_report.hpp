@@ -46,7 +46,8 @@ std::vector<KernelReport> report_kernels(const ResidualProgram &program, const s
 std::string report_json(const std::vector<KernelReport> &kernels,
                         const std::vector<std::string> &effects);
 
-// A readable table of the same.
-std::string report_table(const std::vector<KernelReport> &kernels);
+// A readable table of the same, the effects on a last line.
+std::string report_table(const std::vector<KernelReport> &kernels,
+                         const std::vector<std::string> &effects);
 
 } // namespace sicm

@@ -12,11 +12,12 @@
 #include "algebra/symbolic.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/analyze.hpp"
-#include "eval/parameter.hpp"
 #include "eval/builtins.hpp"
 #include "eval/core.hpp"
+#include "eval/effects_used.hpp"
 #include "eval/number.hpp"
 #include "eval/numerics.hpp"
+#include "eval/parameter.hpp"
 #include "eval/plot.hpp"
 #include "eval/procedure.hpp"
 #include "eval/stdlib.hpp"
@@ -93,6 +94,7 @@ void init_interpreter() {
   install_numerics_primitives();
   install_kernel_primitives();
   install_parameter_primitives();
+  install_effect_primitives();
   load_embedded_stdlib();
   set_first_user_file(register_source("<first user source>", "") + 1);
 }
