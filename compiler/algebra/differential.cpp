@@ -10,6 +10,8 @@
 #include "algebra/differential.hpp"
 
 #include <algorithm>
+#include <cstring>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -347,9 +349,131 @@ bool member(Value v) {
 
 const ArithType kDifferentialArith = {"differential", 15, member, diff_unary, diff_binary};
 
-Value extract_from_procedure_result(NativeProc *self, Value *args, int nargs) {
-  Value r = apply_procedure(self->a, args, nargs);
-  return extract_tangent(r, static_cast<uint32_t>(self->op));
+// ---- tangents of procedures: hiding the tag ------------------------------------
+//
+// The tangent of a procedure-valued result P (D of a curried function) is a
+// procedure T whose calls extract D's tag e from P's results. Calling T once
+// more is one more derivative calculation, so e must be private to T: an
+// argument may carry e from another calculation that reuses this T (f' in
+// (f' (f' g)), the "amazing bug" of Manzyuk, Pearlmutter, Radul, Rush and
+// Siskind, JFP 2019), and P, which closed over x + e, would confuse the two
+// perturbations. So each call that could see e swaps it for a fresh tag e'
+// in the arguments, extracts e from P's result and swaps back, e' becoming
+// the caller's e again (as scmutils's hide-tag-in-procedure does). A tag of a
+// gradient group is hidden with its whole group (a fresh group of the same
+// size), since the group's tags multiply to 0 with each other only.
+//
+// A swap is applied to numbers and expressions (nothing to do), to
+// differentials (tags renamed), to structures and matrices (by component),
+// and to compound procedures, which may have closed over a perturbed value:
+// they are wrapped so that their arguments and results are swapped too.
+// Primitives, literal functions and the other applicable objects (operators,
+// series, compiled kernels) close over no perturbation of a user's
+// calculation and are left as they are; so are lists and vectors.
+
+// The exchange of tags [a, a + n) with [b, b + n) (disjoint ranges).
+struct TagSwap {
+  uint32_t a, b, n;
+};
+
+uint32_t swap_tag(uint32_t t, TagSwap s) {
+  if (t >= s.a && t - s.a < s.n) return t - s.a + s.b;
+  if (t >= s.b && t - s.b < s.n) return t - s.b + s.a;
+  return t;
+}
+
+// A closure or a procedure made in C++ (function_arith.cpp): what may close
+// over a perturbed value.
+bool is_compound_procedure(Value v) {
+  if (v.is(Tag::Closure)) return true;
+  return v.is(Tag::Opaque) && std::strcmp(v.as<Opaque>()->kind->name, "compound-procedure") == 0;
+}
+
+// Might a swap of tags [lo, hi] with fresh ones change v? (A compound
+// procedure might: its closure cannot be searched.)
+bool may_carry_tags(Value v, uint32_t lo, uint32_t hi) {
+  if (is_differential(v)) {
+    Differential *d = as_diff(v);
+    for (size_t i = 0; i < d->n; ++i)
+      for (uint32_t k = 0; k < d->terms[i].ntags; ++k)
+        if (d->terms[i].tags[k] >= lo && d->terms[i].tags[k] <= hi) return true;
+    return false;
+  }
+  if (is_structure(v)) {
+    Structure *s = as_structure(v);
+    for (size_t i = 0; i < s->len; ++i)
+      if (may_carry_tags(s->items[i], lo, hi)) return true;
+    return false;
+  }
+  if (is_matrix(v)) {
+    Matrix *m = as_matrix(v);
+    for (size_t i = 0; i < m->rows * m->cols; ++i)
+      if (may_carry_tags(m->items[i], lo, hi)) return true;
+    return false;
+  }
+  return is_compound_procedure(v);
+}
+
+Value swap_tags(Value v, TagSwap s);
+
+// The procedure a = p under swap items = (a b n): arguments and result swapped.
+Value call_swapped(NativeProc *self, Value *args, int nargs) {
+  TagSwap s{static_cast<uint32_t>(self->items[0].i), static_cast<uint32_t>(self->items[1].i),
+            static_cast<uint32_t>(self->items[2].i)};
+  gcvec<Value> swapped(args, args + nargs);
+  for (Value &x : swapped)
+    x = swap_tags(x, s);
+  return swap_tags(apply_procedure(self->a, swapped.data(), nargs), s);
+}
+
+// v with the tags of s exchanged.
+Value swap_tags(Value v, TagSwap s) {
+  if (is_differential(v)) {
+    gcvec<DTerm> terms = terms_of(v);
+    for (DTerm &t : terms) {
+      std::vector<uint32_t> tags(t.tags, t.tags + t.ntags);
+      for (uint32_t &tag : tags)
+        tag = swap_tag(tag, s);
+      std::sort(tags.begin(), tags.end());
+      t.tags = copy_tags(tags.data(), t.ntags);
+    }
+    return from_terms(std::move(terms));
+  }
+  if (is_structure(v)) {
+    Structure *st = as_structure(v);
+    Value out = make_structure(st->up, st->len);
+    for (size_t i = 0; i < st->len; ++i)
+      as_structure(out)->items[i] = swap_tags(st->items[i], s);
+    return out;
+  }
+  if (is_matrix(v)) {
+    Matrix *m = as_matrix(v);
+    Value out = make_matrix(m->rows, m->cols);
+    for (size_t i = 0; i < m->rows * m->cols; ++i)
+      as_matrix(out)->items[i] = swap_tags(m->items[i], s);
+    return out;
+  }
+  if (is_compound_procedure(v)) {
+    Value items[3] = {Value::fixnum(s.a), Value::fixnum(s.b), Value::fixnum(s.n)};
+    return make_native_procedure(call_swapped, 0, v, Value::nil(), items, 3);
+  }
+  return v;
+}
+
+// The tangent procedure: a = P, op = D's tag e. See above.
+Value call_tangent(NativeProc *self, Value *args, int nargs) {
+  uint32_t e = static_cast<uint32_t>(self->op), lo = e, hi = e;
+  if (long group = group_of(e); group >= 0) std::tie(lo, hi) = g_groups[group];
+  bool hide = false;
+  for (int i = 0; i < nargs && !hide; ++i)
+    hide = may_carry_tags(args[i], lo, hi);
+  if (!hide) return extract_tangent(apply_procedure(self->a, args, nargs), e);
+  uint32_t n = hi - lo + 1;
+  TagSwap s{lo, lo == hi ? fresh_differential_tag() : fresh_gradient_tags(n), n};
+  gcvec<Value> swapped(args, args + nargs);
+  for (Value &x : swapped)
+    x = swap_tags(x, s);
+  return swap_tags(extract_tangent(apply_procedure(self->a, swapped.data(), nargs), e), s);
 }
 
 } // namespace
@@ -464,8 +588,7 @@ Value extract_tangent(Value v, uint32_t tag) {
     return out;
   }
   if (is_procedure(v))
-    return make_native_procedure(extract_from_procedure_result, static_cast<int>(tag), v,
-                                 Value::unspecified());
+    return make_native_procedure(call_tangent, static_cast<int>(tag), v, Value::unspecified());
   Value finite, tangent;
   split_differential(v, tag, &finite, &tangent);
   return tangent;

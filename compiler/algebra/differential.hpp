@@ -39,8 +39,11 @@ uint32_t fresh_gradient_tags(uint32_t n);
 // x + e_tag.
 Value add_infinitesimal(Value x, uint32_t tag);
 // The coefficient of e_tag in v: terms of v carrying the tag, with the tag
-// removed. Maps over structures and matrices, and over procedure results (a
-// procedure-valued v gives a procedure). Values without the tag give 0.
+// removed. Maps over structures and matrices, and over procedure results: a
+// procedure-valued v gives a procedure that extracts the tag from v's
+// results, with the tag private to each of its calls (an argument carrying
+// e_tag from another calculation is not confused with v's own; see "hiding
+// the tag" in differential.cpp). Values without the tag give 0.
 Value extract_tangent(Value v, uint32_t tag);
 // The largest tag in v (searching structures and matrices), or 0 if none.
 uint32_t max_differential_tag(Value v);

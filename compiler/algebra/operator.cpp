@@ -282,10 +282,6 @@ Value P_partial(Value *a, int n) {
   return make_derivative(path);
 }
 
-Value P_derivative(Value *a, int) {
-  return derivative_of(a[0], {});
-}
-
 Value P_operator_p(Value *a, int) {
   return Value::boolean(is_operator(a[0]));
 }
@@ -334,7 +330,11 @@ void install_operator_primitives() {
   register_arith_type(&kOperatorArith);
   define_global("D", make_derivative({}));
   define_primitive("partial", 1, kVariadic, P_partial);
-  define_primitive("derivative", 1, 1, P_derivative);
+  // scmutils's procedure form of D, made an operator as well, so that
+  // operator arithmetic applies: (square derivative) is the second derivative.
+  Value derivative = make_derivative({});
+  as_operator(derivative)->name = intern("derivative");
+  define_global("derivative", derivative);
   define_primitive("operator?", 1, 1, P_operator_p);
   define_primitive("make-operator", 1, 2, P_make_operator);
   define_global("I", identity_operator());

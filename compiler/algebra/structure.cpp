@@ -5,10 +5,12 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "algebra/generic.hpp"
 #include "algebra/linear_solve.hpp"
+#include "algebra/series.hpp"
 #include "algebra/symbolic.hpp"
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
@@ -686,10 +688,26 @@ Value ref_step(Value x, Value idx, int argpos, const char *who) {
   wrong_type(x, 1, who);
 }
 
-// (ref x i j ...): a matrix takes its indices two at a time.
+Value ref_path(Value x, const Value *idx, size_t n, int first_argpos, const char *who);
+
+// ((ref f i ...) x...) is (ref (f x...) i ...): a = f, items = the indices,
+// op = 1 for component (named in errors), 0 for ref.
+Value call_ref_of_value(NativeProc *self, Value *args, int nargs) {
+  return ref_path(apply_procedure(self->a, args, nargs), self->items, self->nitems, 2,
+                  self->op ? "component" : "ref");
+}
+
+// (ref x i j ...): a matrix takes its indices two at a time; a function
+// (not a series) composes with the selection, as in scmutils.
 Value ref_path(Value x, const Value *idx, size_t n, int first_argpos, const char *who) {
   for (size_t k = 0; k < n;) {
     int argpos = first_argpos + static_cast<int>(k);
+    if (is_procedure(x) && !is_series(x)) {
+      for (size_t j = k; j < n; ++j)
+        index_arg(idx[j], first_argpos + static_cast<int>(j), who);
+      int component = std::string_view(who) == "component";
+      return make_native_procedure(call_ref_of_value, component, x, Value::nil(), idx + k, n - k);
+    }
     if (is_matrix(x) && k + 1 < n) {
       Matrix *m = as_matrix(x);
       size_t i = index_arg(idx[k], argpos, who), j = index_arg(idx[k + 1], argpos + 1, who);

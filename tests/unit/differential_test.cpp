@@ -15,6 +15,11 @@ std::string show(Value v) {
   return write_string(expression_to_datum(simplify_value(v)));
 }
 
+// The procedure y |-> a * y, for a captured in the NativeProc.
+Value times_captured(NativeProc *self, Value *args, int) {
+  return g_mul(self->a, args[0]);
+}
+
 } // namespace
 
 TEST(Differential, InfinitesimalSquaredIsZero) {
@@ -66,4 +71,24 @@ TEST(Differential, ExtractionIgnoresOtherTags) {
   EXPECT_EQ(write_string(extract_tangent(v, outer)), "7");
   EXPECT_EQ(write_string(extract_tangent(v, inner)), "9");
   EXPECT_EQ(write_string(extract_tangent(Value::fixnum(4), inner)), "0");
+}
+
+TEST(Differential, TangentOfProcedureHidesItsTag) {
+  // P = y |-> (3 + e) y is what f x = (y |-> x y) gives at x = 3 + e; its
+  // tangent T is y |-> y. Called with an argument that carries e from
+  // another calculation (2 + e), T must give 2 + e, the caller's e intact,
+  // not the coefficient 5 of e in (3 + e)(2 + e) = 6 + 5e.
+  uint32_t e = fresh_differential_tag();
+  Value p = make_native_procedure(times_captured, 0, add_infinitesimal(Value::fixnum(3), e),
+                                  Value::nil());
+  Value t = extract_tangent(p, e);
+  Value arg = add_infinitesimal(Value::fixnum(2), e);
+  Value r = apply_procedure(t, &arg, 1);
+  Value finite, tangent;
+  split_differential(r, e, &finite, &tangent);
+  EXPECT_EQ(write_string(finite), "2");
+  EXPECT_EQ(write_string(tangent), "1");
+  // Without e in the argument, T is just y |-> y.
+  Value seven = Value::fixnum(7);
+  EXPECT_EQ(write_string(apply_procedure(t, &seven, 1)), "7");
 }
