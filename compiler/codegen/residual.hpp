@@ -70,7 +70,7 @@ enum class RKind : uint8_t {
   Text,      // print `text`
   Let,       // var = compute(args)
   Print,     // print var (by its type)
-  Frame,     // plot `plot` = frame(args[0..3]) named `text`, titled `title`
+  Frame,     // plot `plot` = frame(args[0..3]) named `text`, titled `title`, axis_labels
   PlotPoint, // plot-point plot args[0] args[1]
   PlotLine,  // plot-line plot args[0..3]
   Close,     // graphics-close plot
@@ -114,6 +114,7 @@ struct RStmt {
   std::string method;                        // Advance, Evolve: the runtime's step type variable
   std::string text, title;
   std::vector<std::string> probe_texts;    // Advance, Evolve: the probe's outputs as text
+  std::vector<std::string> axis_labels;    // Frame: x, then y (none, one or both)
   SrcLoc loc;                              // the call, for run-time errors
   std::vector<RStmt> then_body, else_body; // If
 };

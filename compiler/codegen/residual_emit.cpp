@@ -437,6 +437,10 @@ private:
               c_string_literal(s.text) + ", " +
               (s.title.empty() ? std::string("NULL") : c_string_literal(s.title)) + ", " + a[0] +
               ", " + a[1] + ", " + a[2] + ", " + a[3] + ");\n";
+      if (!s.axis_labels.empty())
+        code += "sicm_program_plot_labels(" + site(s.loc) + ", plot" + std::to_string(s.plot) +
+                ", " + c_string_literal(s.axis_labels[0]) + ", " +
+                (s.axis_labels.size() > 1 ? c_string_literal(s.axis_labels[1]) : "NULL") + ");\n";
       break;
     }
     case RKind::PlotPoint: {

@@ -1115,6 +1115,8 @@ Value P_frame(Value *a, int n) {
   s.plot = ++g_prog->plots;
   s.title = n > 4 ? std::string(arg_string(a, 4, who)) : "";
   s.text = plot_file_name(s.title, s.plot);
+  for (int i = 5; i < n; ++i) // the axis labels
+    s.axis_labels.emplace_back(arg_string(a, i, who));
   BuildPlot *p = gc_new<BuildPlot>(BuildPlot{s.plot, gc_strdup(s.text)});
   emit(std::move(s));
   return Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kBuildPlotKind, p}));
@@ -2740,7 +2742,7 @@ void begin_build_mode(ResidualProgram *program) {
   rebind("bisect", 4, 5, retrying<P_bisect>);
   rebind("state-advancer", 1, kVariadic, P_state_advancer);
   rebind("evolve", 1, kVariadic, P_evolve);
-  rebind("frame", 4, 5, P_frame);
+  rebind("frame", 4, 7, P_frame);
   rebind("plot-point", 3, 3, P_plot_point);
   rebind("plot-line", 5, 5, P_plot_line);
   rebind("graphics-close", 1, 1, P_graphics_close);

@@ -1,6 +1,8 @@
 // Plot primitives of the interpreter: frame, plot-point, plot-line, ...,
 // over the runtime's plot files (runtime/src/plot.c).
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "eval/core.hpp"
@@ -39,7 +41,7 @@ double arg_real(Value *a, int i, const char *who) {
   return to_double(a[i]);
 }
 
-// (frame xmin xmax ymin ymax [title])
+// (frame xmin xmax ymin ymax [title [x-label y-label]])
 Value P_frame(Value *a, int n) {
   double r[4];
   for (int i = 0; i < 4; ++i)
@@ -49,11 +51,15 @@ Value P_frame(Value *a, int n) {
   ++g_plot_count;
   std::string title = n > 4 ? std::string(arg_string(a, 4, "frame")) : "";
   std::string name = plot_file_name(title, g_plot_count);
+  std::string x_label = n > 5 ? std::string(arg_string(a, 5, "frame")) : "";
+  std::string y_label = n > 6 ? std::string(arg_string(a, 6, "frame")) : "";
   sicm_plot *p = sicm_plot_open(g_plot_dir.c_str(), name.c_str(),
                                 title.empty() ? nullptr : title.c_str(), r[0], r[1], r[2], r[3]);
   if (!p)
-    runtime_error(current_call_loc(),
-                  "frame: cannot create the plot file " + g_plot_dir + "/" + name + ".tsv");
+    runtime_error(current_call_loc(), "frame: cannot create the plot file " + g_plot_dir + "/" +
+                                          name + ".tsv: " + std::strerror(errno));
+  if (n > 5 && sicm_plot_set_labels(p, x_label.c_str(), n > 6 ? y_label.c_str() : nullptr) != 0)
+    runtime_error(current_call_loc(), "frame: out of memory");
   PlotWindow *w = gc_new<PlotWindow>(PlotWindow{p, gc_strdup(name)});
   return Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kPlotKind, w}));
 }
@@ -105,7 +111,7 @@ void set_plot_directory(const std::string &dir) {
 }
 
 void install_plot_primitives() {
-  define_primitive("frame", 4, 5, P_frame);
+  define_primitive("frame", 4, 7, P_frame);
   define_primitive("plot-point", 3, 3, P_plot_point);
   define_primitive("plot-line", 5, 5, P_plot_line);
   define_primitive("graphics-close", 1, 1, P_graphics_close);

@@ -273,10 +273,12 @@ const char *const kKeywords[] = {
 std::vector<std::string> g_matches;
 size_t g_next_match = 0;
 
+// The library's internal helpers are named %...: offered only to a user who
+// types the %.
 std::vector<std::string> names_starting_with(std::string_view prefix) {
   std::set<std::string> names;
   for (const std::string &n : global_names())
-    if (n.starts_with(prefix)) names.insert(n);
+    if (n.starts_with(prefix) && (!n.starts_with("%") || prefix.starts_with("%"))) names.insert(n);
   for (const char *k : kKeywords)
     if (std::string_view(k).starts_with(prefix)) names.insert(k);
   return {names.begin(), names.end()};

@@ -23,6 +23,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "sicm/runtime.h"
@@ -34,8 +35,9 @@ typedef struct {
 } mark;
 
 struct sicm_plot {
-  char *path;  /* NAME without extension, in its directory */
-  char *title; /* shown above the picture */
+  char *path;              /* NAME without extension, in its directory */
+  char *title;             /* shown above the picture */
+  char *x_label, *y_label; /* under the x axis, beside the y axis; NULL for none */
   double xmin, xmax, ymin, ymax;
   FILE *tsv;
   mark *marks;
@@ -124,12 +126,34 @@ static char *dup_string(const char *s) {
   return d;
 }
 
+/* mkdir -p: every missing directory of path, made in turn. 0, or -1 with
+ * errno from the mkdir that failed (EEXIST is not a failure). */
+static int make_directories(const char *path) {
+  char buf[4096];
+  size_t n = strlen(path);
+  if (n == 0 || n >= sizeof buf) return n == 0 ? 0 : (errno = ENAMETOOLONG, -1);
+  memcpy(buf, path, n + 1);
+  for (size_t i = 1; i <= n; ++i) {
+    if (buf[i] != '/' && buf[i] != '\0') continue;
+    char c = buf[i];
+    buf[i] = '\0';
+    if (mkdir(buf, 0777) != 0 && errno != EEXIST) return -1;
+    buf[i] = c;
+  }
+  struct stat st;
+  if (stat(path, &st) != 0) return -1;
+  if (!S_ISDIR(st.st_mode)) return errno = ENOTDIR, -1;
+  return 0;
+}
+
 sicm_plot *sicm_plot_open(const char *dir, const char *name, const char *title, double xmin,
                           double xmax, double ymin, double ymax) {
   if (!(xmax > xmin) || !(ymax > ymin)) {
     errno = EINVAL;
     return NULL;
   }
+  /* --plot-dir names a directory that need not exist yet. */
+  if (dir && make_directories(dir) != 0) return NULL;
   sicm_plot *p = calloc(1, sizeof *p);
   if (!p) return NULL;
   size_t len = strlen(dir ? dir : ".") + strlen(name) + 2;
@@ -162,6 +186,21 @@ sicm_plot *sicm_plot_open(const char *dir, const char *name, const char *title, 
   remember(p);
   leave_operation();
   return p;
+}
+
+int sicm_plot_set_labels(sicm_plot *p, const char *x_label, const char *y_label) {
+  char *x = x_label ? dup_string(x_label) : NULL, *y = y_label ? dup_string(y_label) : NULL;
+  if ((x_label && !x) || (y_label && !y)) {
+    free(x);
+    free(y);
+    errno = ENOMEM;
+    return -1;
+  }
+  free(p->x_label);
+  free(p->y_label);
+  p->x_label = x;
+  p->y_label = y;
+  return 0;
 }
 
 static int add_mark(sicm_plot *p, mark m) {
@@ -268,13 +307,34 @@ static void write_escaped(FILE *f, const char *s) {
   }
 }
 
-/* A tick label: k * step printed with just the decimals the step needs
- * (so 0.46, not .4600000000000001), in plain C notation for SVG readers. */
+/* A tick label: k * step printed with just the digits the step needs
+ * (so 0.46, not .4600000000000001), in plain C notation for SVG readers:
+ * fixed-point between 1e-4 and 1e6, else compact scientific notation
+ * (2e-10, 1.5e7; not 0.0000000002). */
 static void tick_label(char *buf, size_t size, long k, double step) {
   double value = (double)k * step;
+  if (fabs(value) < step * 1e-9) value = 0.0;
+  if (value != 0 && (step < 1e-4 || fabs(value) >= 1e6)) {
+    /* the digits of value down to the step's decade */
+    int decimals = (int)floor(log10(fabs(value)) + 1e-9) - (int)floor(log10(step) + 1e-9);
+    if (decimals < 0) decimals = 0;
+    if (decimals > 15) decimals = 15;
+    char mantissa[64];
+    snprintf(mantissa, sizeof mantissa, "%.*e", decimals, value);
+    char *e = strchr(mantissa, 'e'); /* 2e-05 -> 2e-5, 1.5e+07 -> 1.5e7 */
+    int exponent = atoi(e + 1);
+    *e = '\0';
+    char exponent_text[16];
+    snprintf(exponent_text, sizeof exponent_text, "e%d", exponent);
+    snprintf(buf, size, "%.32s%s", mantissa, exponent_text);
+    return;
+  }
+  if (value == 0 && step < 1e-4) { /* beside 2e-10, not 0.0000000000 */
+    snprintf(buf, size, "0");
+    return;
+  }
   int decimals = step >= 1 ? 0 : (int)ceil(-log10(step) - 1e-9);
   if (decimals > 15) decimals = 15;
-  if (fabs(value) < step * 1e-9) value = 0.0;
   snprintf(buf, size, "%.*f", decimals, value);
 }
 
@@ -347,6 +407,19 @@ static int write_svg(const sicm_plot *p) {
       f, "<clipPath id=\"frame\"><rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\"/></clipPath>\n",
       kLeft, kTop, kWidth - kLeft - kRight, kHeight - kTop - kBottom);
   write_ticks(f, p);
+  if (p->x_label) {
+    fprintf(f, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">",
+            kLeft + (kWidth - kLeft - kRight) / 2, kHeight - 10);
+    write_escaped(f, p->x_label);
+    fputs("</text>\n", f);
+  }
+  if (p->y_label) {
+    const int x = 16, y = kTop + (kHeight - kTop - kBottom) / 2;
+    fprintf(f, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\" transform=\"rotate(-90 %d %d)\">", x,
+            y, x, y);
+    write_escaped(f, p->y_label);
+    fputs("</text>\n", f);
+  }
   fputs("<g clip-path=\"url(#frame)\">\n", f);
   write_marks(f, p);
   fputs("</g>\n</svg>\n", f);
@@ -385,6 +458,8 @@ void sicm_plot_free(sicm_plot *p) {
   free(p->marks);
   free(p->path);
   free(p->title);
+  free(p->x_label);
+  free(p->y_label);
   free(p);
 }
 

@@ -162,6 +162,12 @@ sicm_plot *sicm_program_frame(const sicm_site *site, const char *name, const cha
   return p;
 }
 
+void sicm_program_plot_labels(const sicm_site *site, sicm_plot *plot, const char *x_label,
+                              const char *y_label) {
+  if (sicm_plot_set_labels(plot, x_label, y_label) != 0)
+    sicm_program_fail(site, "frame", "out of memory");
+}
+
 void sicm_program_plot_point(const sicm_site *site, sicm_plot *plot, double x, double y) {
   if (sicm_plot_point(plot, x, y) != 0)
     sicm_program_fail(site, "plot-point", "the plot is closed or memory is exhausted");

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -83,4 +84,33 @@ TEST(Plot, MarksAfterFinishAreRefused) {
   sicm_plot_finish(p);
   EXPECT_EQ(sicm_plot_point(p, 0.5, 0.5), -1);
   sicm_plot_free(p);
+}
+
+// --plot-dir may name a directory that does not exist yet: it is made.
+TEST(Plot, MissingDirectoriesAreCreated) {
+  std::string dir = temp_dir() + "/a/b";
+  sicm_plot *p = sicm_plot_open(dir.c_str(), "r", nullptr, 0, 1, 0, 1);
+  ASSERT_NE(p, nullptr);
+  sicm_plot_free(p);
+  EXPECT_TRUE(exists(dir + "/r.svg"));
+  std::string file = temp_dir() + "/file";
+  std::ofstream(file) << "x";
+  errno = 0;
+  EXPECT_EQ(sicm_plot_open((file + "/c").c_str(), "r", nullptr, 0, 1, 0, 1), nullptr);
+  EXPECT_EQ(errno, ENOTDIR);
+}
+
+// Ticks over a tiny range are written compactly, and the axes carry labels.
+TEST(Plot, TinyTicksAreCompactAndAxesAreLabelled) {
+  std::string dir = temp_dir();
+  sicm_plot *p = sicm_plot_open(dir.c_str(), "s", nullptr, 0, 1, 0, 1e-9);
+  ASSERT_NE(p, nullptr);
+  ASSERT_EQ(sicm_plot_set_labels(p, "t (s)", "x<y"), 0);
+  sicm_plot_free(p);
+  std::string svg = slurp(dir + "/s.svg");
+  EXPECT_NE(svg.find(">2e-10</text>"), std::string::npos) << svg;
+  EXPECT_NE(svg.find(">0</text>"), std::string::npos);
+  EXPECT_EQ(svg.find("0.0000000002"), std::string::npos);
+  EXPECT_NE(svg.find(">t (s)</text>"), std::string::npos);
+  EXPECT_NE(svg.find(">x&lt;y</text>"), std::string::npos);
 }

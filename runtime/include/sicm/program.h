@@ -78,11 +78,16 @@ void sicm_print_boolean(double x);
 double sicm_real_time(void);
 double sicm_run_time(void);
 
-/* (frame xmin xmax ymin ymax [title]) and the marks added to it; a plot file
- * that cannot be created or written is a failure at `site`. NAME is the file
- * name without extension, TITLE may be NULL. */
+/* (frame xmin xmax ymin ymax [title [x-label y-label]]) and the marks added
+ * to it; a plot file that cannot be created or written is a failure at
+ * `site`, with the system's reason. NAME is the file name without
+ * extension, TITLE may be NULL; the plot directory (--plot-dir) is created
+ * if it does not exist. sicm_program_plot_labels labels the axes (y_label
+ * may be NULL). */
 sicm_plot *sicm_program_frame(const sicm_site *site, const char *name, const char *title,
                               double xmin, double xmax, double ymin, double ymax);
+void sicm_program_plot_labels(const sicm_site *site, sicm_plot *plot, const char *x_label,
+                              const char *y_label);
 void sicm_program_plot_point(const sicm_site *site, sicm_plot *plot, double x, double y);
 void sicm_program_plot_line(const sicm_site *site, sicm_plot *plot, double x0, double y0, double x1,
                             double y1);

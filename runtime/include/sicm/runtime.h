@@ -15,8 +15,8 @@
 #include "sicm/linalg.h"
 #include "sicm/min.h"
 #include "sicm/ode.h"
-#include "sicm/quad.h"
 #include "sicm/program.h"
+#include "sicm/quad.h"
 #include "sicm/root.h"
 #include "sicm/stats.h"
 
@@ -54,10 +54,14 @@ size_t sicm_shortest_digits(char *digits, int *exponent10, double x);
  * success and -1 with errno set on failure. */
 typedef struct sicm_plot sicm_plot;
 
-/* Open a plot; dir NULL means ".", title NULL means name. NULL on failure
- * (errno EINVAL for an empty range). */
+/* Open a plot; dir NULL means ".", title NULL means name. dir and its
+ * parents are created if they do not exist. NULL on failure, errno saying
+ * why (EINVAL for an empty range; mkdir's or fopen's reason otherwise). */
 sicm_plot *sicm_plot_open(const char *dir, const char *name, const char *title, double xmin,
                           double xmax, double ymin, double ymax);
+/* Label the axes (either NULL for none): x_label under the x axis, y_label
+ * beside the y axis, written into the SVG. */
+int sicm_plot_set_labels(sicm_plot *p, const char *x_label, const char *y_label);
 int sicm_plot_point(sicm_plot *p, double x, double y);
 int sicm_plot_line(sicm_plot *p, double x0, double y0, double x1, double y1);
 /* Number of marks (points and segments) added so far. */
