@@ -854,6 +854,8 @@ std::string method_of(Value *a, int n, int i, const char *who) {
       i < n && !a[i].is(Tag::Default) ? a[i] : intern("*ode-integration-method*").symbol()->global;
   const char *c = is_symbol(m) ? integrator_c_name(symbol_name(m)) : nullptr;
   if (!c) {
+    std::string why = is_symbol(m) ? integrator_not_provided(symbol_name(m)) : "";
+    if (!why.empty()) runtime_error(here(), std::string(who) + ": " + why);
     if (i < n) bad_range(a[i], i + 1, who);
     runtime_error(here(), std::string(who) + ": *ode-integration-method* is " + write_string(m) +
                               ", which names no integrator");

@@ -419,6 +419,8 @@ const sicm_ode_step_type *const sicm_ode_step_cvode_adams = &sicm_ode_cvode_adam
 const sicm_ode_step_type *const sicm_ode_step_cvode_bdf = &sicm_ode_cvode_bdf_type;
 const sicm_ode_step_type *const sicm_ode_step_taylor = &sicm_ode_taylor_type;
 const sicm_ode_step_type *const sicm_ode_step_taylor_extended = &sicm_ode_taylor_extended_type;
+const sicm_ode_step_type *const sicm_ode_step_qcrk4 = &sicm_ode_qcrk4_type;
+const sicm_ode_step_type *const sicm_ode_step_qcctrap2 = &sicm_ode_qcctrap2_type;
 
 /* ---- the public driver ------------------------------------------------ */
 

@@ -8,7 +8,8 @@
 
 /* A step type is a small table of functions (a "backend"). ode.c implements
  * the GSL steppers, ode_bs.c Bulirsch-Stoer, ode_cvode.c CVODE, ode_taylor.c
- * Taylor series from generated coefficients. The driver
+ * Taylor series from generated coefficients, ode_qc.c scmutils'
+ * quality-controlled qcrk4 and qcctrap2. The driver
  * in ode.c validates arguments, notices when the caller has moved the
  * state between calls, and keeps statistics of rhs calls; the backend does
  * the stepping.
@@ -152,5 +153,7 @@ extern const sicm_ode_step_type sicm_ode_cvode_adams_type;
 extern const sicm_ode_step_type sicm_ode_cvode_bdf_type;
 extern const sicm_ode_step_type sicm_ode_taylor_type;
 extern const sicm_ode_step_type sicm_ode_taylor_extended_type;
+extern const sicm_ode_step_type sicm_ode_qcrk4_type;
+extern const sicm_ode_step_type sicm_ode_qcctrap2_type;
 
 #endif /* SICM_ODE_INTERNAL_H */

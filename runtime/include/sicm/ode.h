@@ -35,11 +35,26 @@ typedef int (*sicm_ode_jacobian)(double t, const double *y, double *dfdy, double
  *   sicm_ode_step_rkck         Cash-Karp 4(5), GSL.
  *   sicm_ode_step_msbdf        Variable-order (1-5) BDF, GSL, for stiff problems;
  *                              uses the Jacobian (finite differences if none is set).
+ *                              This is Gear's method: scmutils' gear and
+ *                              explicit-gear, one method there (variable-order (1-4)
+ *                              BDF with Newton iteration on the Jacobian), run as it.
  *   sicm_ode_step_bs           Bulirsch-Stoer: Gragg's modified midpoint rule with
  *                              polynomial extrapolation, adaptive order and step
  *                              (Deuflhard; Hairer-Norsett-Wanner). The default of
  *                              scmutils and SICM; very efficient at tight
  *                              tolerances on smooth non-stiff problems.
+ *   sicm_ode_step_qcrk4        scmutils' qcrk4: classical RK4 made adaptive by step
+ *                              doubling (a step h against two of h/2) with local
+ *                              extrapolation (the two half steps plus their difference
+ *                              from the whole step over 15: order 5). Explicit; 11 rhs
+ *                              evaluations a step. Error measured as scmutils does,
+ *                              relative (see Tolerances below).
+ *   sicm_ode_step_qcctrap2     scmutils' qcctrap2: the trapezoid rule, solved by
+ *                              corrector (fixed-point) iteration from an Euler
+ *                              predictor, with the same step doubling and
+ *                              extrapolation (order 3). Implicit, but the iteration
+ *                              converges only for h |lambda| < 2, so it is no help
+ *                              on stiff problems. Error measured as for qcrk4.
  *   sicm_ode_step_cvode_adams  SUNDIALS CVODE, variable-order (1-12) Adams-Moulton
  *                              with fixed-point iteration; non-stiff.
  *   sicm_ode_step_cvode_bdf    SUNDIALS CVODE, variable-order (1-5) BDF with Newton
@@ -84,6 +99,8 @@ extern const sicm_ode_step_type *const sicm_ode_step_rkf45;
 extern const sicm_ode_step_type *const sicm_ode_step_rkck;
 extern const sicm_ode_step_type *const sicm_ode_step_msbdf;
 extern const sicm_ode_step_type *const sicm_ode_step_bs;
+extern const sicm_ode_step_type *const sicm_ode_step_qcrk4;
+extern const sicm_ode_step_type *const sicm_ode_step_qcctrap2;
 extern const sicm_ode_step_type *const sicm_ode_step_cvode_adams;
 extern const sicm_ode_step_type *const sicm_ode_step_cvode_bdf;
 extern const sicm_ode_step_type *const sicm_ode_step_verlet;
@@ -114,7 +131,17 @@ const char *sicm_ode_step_type_name(const sicm_ode_step_type *T);
  * components of e_i / (abs_tol + rel_tol |y_i|), which is at most the
  * maximum, so their test is slightly looser, and their error estimates are
  * less conservative: at equal tolerances their global errors are typically
- * 10 to 100 times those of the one-step methods. The tolerances bound the
+ * 10 to 100 times those of the one-step methods. qcrk4 and qcctrap2 measure
+ * as scmutils does: the difference d_i of a step taken whole and in two
+ * halves, relative to the mean size m_i of the two results, is accepted when
+ * for every component
+ *
+ *     |d_i| <= 2 rel_tol (m_i + 1e-10)
+ *
+ * (1e-10 is scmutils' size below which the measure turns absolute); abs_tol
+ * is not used unless rel_tol is 0, when the test is |d_i| <= 2 abs_tol. The
+ * extrapolated result is far more accurate than d_i, so at equal tolerances
+ * their errors are far smaller than the other methods'. The tolerances bound the
  * error committed in one step, not the global error, which accumulates over
  * the steps (and can grow exponentially for unstable or chaotic systems).
  *
@@ -188,7 +215,9 @@ int sicm_ode_set_max_steps(sicm_ode *o, unsigned long max_steps);
  * (times and components are printed as the compiler prints numbers; at most
  * 16 components are shown).
  *
- * The explicit methods (rk8pd, rkf45, rkck, bs) watch for stiffness: when
+ * The explicit methods (rk8pd, rkf45, rkck, bs, qcrk4) and qcctrap2, whose
+ * corrector iteration limits its step as stability limits theirs, watch
+ * for stiffness: when
  * their step has been held by the method's stability, not by the tolerance,
  * for some 800 steps and reaching t1 would take more than 1e5 further steps,
  * they stop with SICM_ESTIFF, saying so and naming cvode-bdf. A short run is
