@@ -7,7 +7,7 @@
 //
 // The unroll limits of sicm build are different: hitting one is never an
 // error. Past them the partial evaluator generalizes (leaves a loop for run
-// time) instead of unrolling it (see eval/builtins_build.cpp).
+// time) instead of unrolling it (see eval/build_loops.cpp).
 #pragma once
 
 #include <atomic>
