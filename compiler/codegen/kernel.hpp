@@ -50,6 +50,7 @@ struct Kernel {
   KernelFn fn = nullptr;
   size_t nin = 0, nout = 0;
   Value arg_shapes;     // the sample arguments as given (a list): their shapes
+  Value source;         // the procedure compiled (applied to arguments that are not numbers)
   Value result_shape;   // a structure of the result's shape, or a number for a scalar result
   std::string name;     // the procedure's name as the user wrote it (for printing)
   std::string c_name;   // the C function's name (generated, [A-Za-z0-9_] only)

@@ -298,6 +298,7 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   k->nin = t.inputs.size();
   k->nout = t.outputs.size();
   k->arg_shapes = sample_args;
+  k->source = proc;
   k->result_shape = t.result_shape;
   k->name = kname;
   k->c_name = c_name;

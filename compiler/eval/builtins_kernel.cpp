@@ -3,13 +3,17 @@
 // (compile-procedure proc sample ...) traces proc on arguments shaped like the
 // samples and returns a kernel: an applicable object that flattens its
 // arguments, runs the native code and rebuilds the result (always flonums). It
-// prints as #[kernel NAME]. A procedure that cannot be compiled is returned as
-// it is, after a note on stderr saying why, so a program keeps working,
+// prints as #[kernel NAME]. Arguments shaped like the samples but with leaves
+// that are not numbers (symbols, or the run-time values of `sicm build`,
+// which traces what a kernel computes into the executable) go to the
+// procedure itself. A procedure that cannot be compiled is returned as it
+// is, after a note on stderr saying why, so a program keeps working,
 // interpreted; (kernel? x) tells the two apart.
 #include <cstdio>
 #include <string>
 #include <vector>
 
+#include "algebra/structure.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
@@ -40,6 +44,17 @@ Kernel *as_kernel(Value v) {
   return static_cast<Kernel *>(v.as<Opaque>()->obj);
 }
 
+// Is v shaped like shape, whatever its leaves are?
+bool has_structure_of(Value v, Value shape) {
+  if (!is_structure(shape)) return !is_structure(v);
+  if (!is_structure(v)) return false;
+  Structure *a = as_structure(v), *b = as_structure(shape);
+  if (a->up != b->up || a->len != b->len) return false;
+  for (size_t i = 0; i < a->len; ++i)
+    if (!has_structure_of(a->items[i], b->items[i])) return false;
+  return true;
+}
+
 // Check the arguments against the kernel's shapes, flatten, run, rebuild.
 Value apply_kernel(void *obj, Value *args, int nargs) {
   auto *k = static_cast<Kernel *>(obj);
@@ -52,6 +67,14 @@ Value apply_kernel(void *obj, Value *args, int nargs) {
   thread_local std::vector<double> in, out;
   in.clear();
   Value shapes = k->arg_shapes;
+  bool numbers = true, structured = true;
+  Value s = shapes;
+  for (int i = 0; i < nargs; ++i, s = cdr(s)) {
+    numbers = numbers && value_has_shape(args[i], car(s));
+    structured = structured && has_structure_of(args[i], car(s));
+  }
+  if (!numbers && structured && is_procedure(k->source))
+    return apply_procedure(k->source, args, nargs);
   for (int i = 0; i < nargs; ++i, shapes = cdr(shapes)) {
     if (!value_has_shape(args[i], car(shapes))) wrong_type(args[i], i + 1, k->name.c_str());
     flatten_value(args[i], in, k->name.c_str());
