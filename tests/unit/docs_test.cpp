@@ -11,6 +11,8 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
@@ -85,3 +87,30 @@ TEST(Docs, EveryPrimitiveIsDocumented) {
 }
 
 } // namespace
+
+// ARCHITECTURE.md lists every source file of the compiler, the runtime and
+// the library (one line each, in its folder's table), so a new file must be
+// placed on the map when it is added.
+TEST(Docs, ArchitectureListsEverySourceFile) {
+  if (!in_repository_root()) GTEST_SKIP() << "not run from the repository root";
+  std::ifstream in("ARCHITECTURE.md");
+  ASSERT_TRUE(in) << "ARCHITECTURE.md is missing";
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string map = text.str();
+  int checked = 0;
+  for (const char *dir : {"compiler", "runtime", "stdlib"}) {
+    for (const auto &entry : std::filesystem::recursive_directory_iterator(dir)) {
+      const std::string ext = entry.path().extension().string();
+      if (!entry.is_regular_file() ||
+          (ext != ".cpp" && ext != ".hpp" && ext != ".c" && ext != ".h" && ext != ".def" &&
+           ext != ".sicm"))
+        continue;
+      const std::string name = entry.path().filename().string();
+      EXPECT_NE(map.find("`" + name + "`"), std::string::npos)
+          << entry.path().string() << " is not in ARCHITECTURE.md";
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
