@@ -511,12 +511,13 @@ std::string emit_taylor_function(const Trace &t, const std::string &c_name, std:
 // The sums are convolutions, and a sum accumulated in one variable waits on
 // the latency of each addition (4 cycles) while the multiplications would
 // go at one a cycle: each sum keeps four partial sums (the order of the
-// additions changes, their accuracy does not). Written once over `real`
-// and instantiated for double and long double (taylor-extended).
+// additions changes, their accuracy does not). Written once over the
+// macros REAL, TC(name) and POW, SQRT, ... and instantiated for double and
+// long double (taylor-extended) by defining them around it.
 static const char kTaylorSupport[] = R"(
 /* sum_{j=lo}^{hi} w(j) a[j] b[k-j], four partial sums; W is the weight. */
 #define SICM_TC_DOT(W)                                                          \
-  real s0 = 0, s1 = 0, s2 = 0, s3 = 0;                                         \
+  REAL s0 = 0, s1 = 0, s2 = 0, s3 = 0;                                         \
   int j = lo;                                                                  \
   for (; j + 3 <= hi; j += 4) {                                                \
     s0 += W(j) * a[j] * b[k - j];                                              \
@@ -527,125 +528,125 @@ static const char kTaylorSupport[] = R"(
   for (; j <= hi; ++j) s0 += W(j) * a[j] * b[k - j];                           \
   return (s0 + s1) + (s2 + s3)
 #define SICM_TC_ONE(j) 1
-#define SICM_TC_J(j) (real)(j)
+#define SICM_TC_J(j) (REAL)(j)
 
-static inline real tc_dot(const real *a, const real *b, int lo, int hi, int k) {
+static inline REAL TC(dot)(const REAL *a, const REAL *b, int lo, int hi, int k) {
   SICM_TC_DOT(SICM_TC_ONE);
 }
 
 /* sum_{j=lo}^{hi} j a[j] b[k-j] */
-static inline real tc_jdot(const real *a, const real *b, int lo, int hi, int k) {
+static inline REAL TC(jdot)(const REAL *a, const REAL *b, int lo, int hi, int k) {
   SICM_TC_DOT(SICM_TC_J);
 }
 
-static inline real tc_product(const real *a, const real *b, int k) {
-  return tc_dot(a, b, 0, k, k);
+static inline REAL TC(product)(const REAL *a, const REAL *b, int k) {
+  return TC(dot)(a, b, 0, k, k);
 }
 
 /* a * a: the convolution is symmetric, half the products. */
-static inline real tc_square(const real *a, int k) {
+static inline REAL TC(square)(const REAL *a, int k) {
   if (k == 0) return a[0] * a[0];
-  const real *b = a;
-  real half = tc_dot(a, b, 0, (k - 1) / 2, k);
+  const REAL *b = a;
+  REAL half = TC(dot)(a, b, 0, (k - 1) / 2, k);
   return 2 * half + (k % 2 == 0 ? a[k / 2] * a[k / 2] : 0);
 }
 
 /* q = a / b, given a's coefficient k. */
-static inline void tc_quotient(real *q, real a_k, const real *b, int k) {
-  q[k] = (a_k - tc_dot(b, q, 1, k, k)) / b[0];
+static inline void TC(quotient)(REAL *q, REAL a_k, const REAL *b, int k) {
+  q[k] = (a_k - TC(dot)(b, q, 1, k, k)) / b[0];
 }
 
 /* v = u^alpha: u v' = alpha u' v, so
  * k u0 v_k = sum_{i=1}^{k} (alpha i - (k - i)) u_i v_{k-i}
  *          = sum_{i=1}^{k} ((alpha + 1) i - k) u_i v_{k-i}. */
-#define SICM_TC_POWER_WEIGHT(j) (alpha1 * (real)(j) - (real)k)
-static inline real tc_power_dot(const real *a, const real *b, int lo, int hi, int k,
-                                real alpha1) {
+#define SICM_TC_POWER_WEIGHT(j) (alpha1 * (REAL)(j) - (REAL)k)
+static inline REAL TC(power_dot)(const REAL *a, const REAL *b, int lo, int hi, int k,
+                                REAL alpha1) {
   SICM_TC_DOT(SICM_TC_POWER_WEIGHT);
 }
 
-static inline void tc_power(real *v, const real *u, real alpha, int k) {
+static inline void TC(power)(REAL *v, const REAL *u, REAL alpha, int k) {
   if (k == 0) {
     v[0] = POW(u[0], alpha);
     return;
   }
-  v[k] = tc_power_dot(u, v, 1, k, k, alpha + 1) / (k * u[0]);
+  v[k] = TC(power_dot)(u, v, 1, k, k, alpha + 1) / (k * u[0]);
 }
 
-static inline void tc_sqrt(real *v, const real *u, int k) {
+static inline void TC(sqrt)(REAL *v, const REAL *u, int k) {
   if (k == 0) {
     v[0] = SQRT(u[0]);
     return;
   }
   /* u_k = sum_{j=0}^{k} v_j v_{k-j}: the inner terms, symmetric. */
-  const real *a = v, *b = v;
-  real inner = 2 * tc_dot(a, b, 1, (k - 1) / 2, k) + (k % 2 == 0 ? v[k / 2] * v[k / 2] : 0);
+  const REAL *a = v, *b = v;
+  REAL inner = 2 * TC(dot)(a, b, 1, (k - 1) / 2, k) + (k % 2 == 0 ? v[k / 2] * v[k / 2] : 0);
   v[k] = (u[k] - inner) / (2 * v[0]);
 }
 
-static inline void tc_exp(real *v, const real *u, int k) {
+static inline void TC(exp)(REAL *v, const REAL *u, int k) {
   if (k == 0) {
     v[0] = EXP(u[0]);
     return;
   }
-  v[k] = tc_jdot(u, v, 1, k, k) / k;
+  v[k] = TC(jdot)(u, v, 1, k, k) / k;
 }
 
 /* u v' = u': k u0 v_k = k u_k - sum_{j=1}^{k-1} j v_j u_{k-j}. */
-static inline void tc_log(real *v, const real *u, int k) {
+static inline void TC(log)(REAL *v, const REAL *u, int k) {
   if (k == 0) {
     v[0] = LOG(u[0]);
     return;
   }
-  v[k] = (u[k] - tc_jdot(v, u, 1, k - 1, k) / k) / u[0];
+  v[k] = (u[k] - TC(jdot)(v, u, 1, k - 1, k) / k) / u[0];
 }
 
 /* The pair s, c with s' = c u' and c' = sign s u' (sin and cos: sign -1;
  * sinh and cosh: sign +1), at order k >= 1. */
-static inline void tc_pair(real *s, real *c, const real *u, int k, real sign) {
-  real a = tc_jdot(u, c, 1, k, k), b = tc_jdot(u, s, 1, k, k);
+static inline void TC(pair)(REAL *s, REAL *c, const REAL *u, int k, REAL sign) {
+  REAL a = TC(jdot)(u, c, 1, k, k), b = TC(jdot)(u, s, 1, k, k);
   s[k] = a / k;
   c[k] = sign * b / k;
 }
 
-static inline void tc_sincos(real *s, real *c, const real *u, int k) {
+static inline void TC(sincos)(REAL *s, REAL *c, const REAL *u, int k) {
   if (k == 0) {
     s[0] = SIN(u[0]);
     c[0] = COS(u[0]);
   } else {
-    tc_pair(s, c, u, k, -1);
+    TC(pair)(s, c, u, k, -1);
   }
 }
 
-static inline void tc_sinhcosh(real *s, real *c, const real *u, int k) {
+static inline void TC(sinhcosh)(REAL *s, REAL *c, const REAL *u, int k) {
   if (k == 0) {
     s[0] = SINH(u[0]);
     c[0] = COSH(u[0]);
   } else {
-    tc_pair(s, c, u, k, 1);
+    TC(pair)(s, c, u, k, 1);
   }
 }
 
 /* v = atan2(y, x): r v' = x y' - y x' with r = x^2 + y^2 (kept in r):
  * k r0 v_k = sum_{j=0}^{k-1} (k - j) (x_j y_{k-j} - y_j x_{k-j})
  *            - sum_{j=1}^{k-1} (k - j) r_j v_{k-j}. */
-static inline void tc_atan2(real *v, const real *y, const real *x, real *r, int k) {
-  r[k] = tc_square(x, k) + tc_square(y, k);
+static inline void TC(atan2)(REAL *v, const REAL *y, const REAL *x, REAL *r, int k) {
+  r[k] = TC(square)(x, k) + TC(square)(y, k);
   if (k == 0) {
     v[0] = ATAN2(y[0], x[0]);
     return;
   }
   /* with i = k - j: sum_{i=1}^{k} i (x_{k-i} y_i - y_{k-i} x_i), and
    * sum_{i=1}^{k-1} i v_i r_{k-i} */
-  real d = tc_jdot(y, x, 1, k, k) - tc_jdot(x, y, 1, k, k) - tc_jdot(v, r, 1, k - 1, k);
+  REAL d = TC(jdot)(y, x, 1, k, k) - TC(jdot)(x, y, 1, k, k) - TC(jdot)(v, r, 1, k - 1, k);
   v[k] = d / (k * r[0]);
 }
 /* x = M^-1 b for series M (n x n, row-major) and b, by M x = b order by
  * order: M_0 x_k = b_k - sum_{j=1}^{k} M_j x_{k-j}. At k = 0, M_0 is
  * factored (LU with partial pivoting) into lu and pivots, kept for the
  * other orders; a singular M_0 gives NaN coefficients. */
-static inline void tc_solve(int n, const real *const *m, const real *const *b, real *const *x,
-                            real *lu, int *pivots, real *r, int k) {
+static inline void TC(solve)(int n, const REAL *const *m, const REAL *const *b, REAL *const *x,
+                            REAL *lu, int *pivots, REAL *r, int k) {
   if (k == 0) {
     for (int i = 0; i < n * n; ++i) lu[i] = m[i][0];
     for (int c = 0; c < n; ++c) {
@@ -654,24 +655,24 @@ static inline void tc_solve(int n, const real *const *m, const real *const *b, r
         if (FABS(lu[i * n + c]) > FABS(lu[p * n + c])) p = i;
       pivots[c] = p;
       for (int j = 0; p != c && j < n; ++j) {
-        real t = lu[c * n + j];
+        REAL t = lu[c * n + j];
         lu[c * n + j] = lu[p * n + j];
         lu[p * n + j] = t;
       }
       if (lu[c * n + c] == 0) lu[c * n + c] = NAN;
       for (int i = c + 1; i < n; ++i) {
-        real f = lu[i * n + c] /= lu[c * n + c];
+        REAL f = lu[i * n + c] /= lu[c * n + c];
         for (int j = c + 1; j < n; ++j) lu[i * n + j] -= f * lu[c * n + j];
       }
     }
   }
   for (int i = 0; i < n; ++i) {
-    real s = b[i][k];
-    for (int j = 0; j < n; ++j) s -= tc_dot(m[i * n + j], x[j], 1, k, k);
+    REAL s = b[i][k];
+    for (int j = 0; j < n; ++j) s -= TC(dot)(m[i * n + j], x[j], 1, k, k);
     r[i] = s;
   }
   for (int c = 0; c < n; ++c) {
-    real t = r[c];
+    REAL t = r[c];
     r[c] = r[pivots[c]];
     r[pivots[c]] = t;
   }
@@ -691,52 +692,30 @@ static inline void tc_solve(int n, const real *const *m, const real *const *b, r
 
 namespace {
 
-// kTaylorSupport with its names made those of one precision: `real`, the
-// tc_ prefix and the math functions (POW, SQRT, ...).
+// The macros kTaylorSupport is written over, for one precision.
+const char *const kMathNames[] = {"POW",  "SQRT", "EXP", "LOG",   "SINH",
+                                  "COSH", "SIN",  "COS", "ATAN2", "FABS"};
+
 std::string instantiate(TaylorPrecision precision) {
   const bool extended = precision == TaylorPrecision::Extended;
-  const std::pair<const char *, const char *> names[] = {
-      {"real", extended ? "long double" : "double"},
-      {"tc_", extended ? "sicm_tcl_" : "sicm_tc_"},
-      {"SICM_TC_", extended ? "SICM_TCL_" : "SICM_TC_"},
-      {"POW", extended ? "powl" : "pow"},
-      {"SQRT", extended ? "sqrtl" : "sqrt"},
-      {"EXP", extended ? "expl" : "exp"},
-      {"LOG", extended ? "logl" : "log"},
-      {"SINH", extended ? "sinhl" : "sinh"},
-      {"COSH", extended ? "coshl" : "cosh"},
-      {"SIN", extended ? "sinl" : "sin"},
-      {"COS", extended ? "cosl" : "cos"},
-      {"ATAN2", extended ? "atan2l" : "atan2"},
-      {"FABS", extended ? "fabsl" : "fabs"},
-  };
-  std::string out;
-  const std::string text = kTaylorSupport;
-  for (size_t i = 0; i < text.size();) {
-    bool replaced = false;
-    bool word_start =
-        i == 0 || !(std::isalnum(static_cast<unsigned char>(text[i - 1])) || text[i - 1] == '_');
-    for (const auto &[from, to] : names) {
-      size_t n = std::strlen(from);
-      bool prefix = from[std::strlen(from) - 1] == '_';
-      if (!word_start || text.compare(i, n, from) != 0) continue;
-      char next = i + n < text.size() ? text[i + n] : ' ';
-      if (!prefix && (std::isalnum(static_cast<unsigned char>(next)) || next == '_')) continue;
-      out += to;
-      i += n;
-      replaced = true;
-      break;
-    }
-    if (!replaced) out += text[i++];
+  std::string defines = std::string("#define REAL ") + (extended ? "long double" : "double") +
+                        "\n#define TC(name) " + (extended ? "sicm_tcl_" : "sicm_tc_") + "##name\n";
+  std::string undefs = "#undef REAL\n#undef TC\n";
+  for (const char *name : kMathNames) {
+    std::string c = name;
+    for (char &ch : c)
+      ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    defines += std::string("#define ") + name + " " + c + (extended ? "l" : "") + "\n";
+    undefs += std::string("#undef ") + name + "\n";
   }
-  return out;
+  return defines + kTaylorSupport + undefs;
 }
 
 } // namespace
 
 std::string c_taylor_support(TaylorPrecision precision) {
   return std::string("/* Taylor-coefficient recurrences (sicm's Taylor emitter), in ") +
-         (precision == TaylorPrecision::Extended ? "long double" : "double") + ". */" +
+         (precision == TaylorPrecision::Extended ? "long double" : "double") + ". */\n" +
          instantiate(precision) + "\n";
 }
 
