@@ -248,6 +248,15 @@ int sicm_ode_fail_user(sicm_ode *o, double t, const double *y) {
   return sicm_ode_fail(o, SICM_EUSER, t, y, "stopped by the system", detail);
 }
 
+int sicm_ode_start_derivative(sicm_ode *o, double t, const double *y, double *f0) {
+  int s = sicm_ode_call_rhs(o, t, y, f0);
+  if (s == SICM_EUSER) return sicm_ode_fail_user(o, t, y);
+  if (s != SICM_SUCCESS)
+    return sicm_ode_fail(o, SICM_EBADFUNC, t, y, "non-finite derivative",
+                         "the right-hand side is NaN or infinite at this point");
+  return SICM_SUCCESS;
+}
+
 int sicm_ode_fail_max_steps(sicm_ode *o, double t, const double *y) {
   char detail[160];
   snprintf(detail, sizeof detail,

@@ -124,6 +124,12 @@ int sicm_ode_fail(sicm_ode *o, int status, double t, const double *y, const char
 
 /* The messages of the usual failures, shared so all backends say the same. */
 int sicm_ode_fail_user(sicm_ode *o, double t, const double *y);
+
+/* The derivative f0 at the point (t, y) a step starts from, for the
+ * backends that keep it between steps (Bulirsch-Stoer, the qc methods):
+ * SICM_SUCCESS, or the failure already reported (the user's status, or a
+ * non-finite derivative). */
+int sicm_ode_start_derivative(sicm_ode *o, double t, const double *y, double *f0);
 int sicm_ode_fail_max_steps(sicm_ode *o, double t, const double *y);
 
 /* Where an explicit method is stable on y' = lambda y: the largest |h lambda|

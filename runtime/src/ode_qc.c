@@ -274,11 +274,8 @@ static int qc_evolve(sicm_ode *o, double *t, double t1, double *y) {
   unsigned long steps = 0;
   while (*t != t1) {
     if (!b->f0_valid) {
-      int s = sicm_ode_call_rhs(o, *t, y, b->f0);
-      if (s == SICM_EUSER) return sicm_ode_fail_user(o, *t, y);
-      if (s != SICM_SUCCESS)
-        return sicm_ode_fail(o, SICM_EBADFUNC, *t, y, "non-finite derivative",
-                             "the right-hand side is NaN or infinite at this point");
+      int s = sicm_ode_start_derivative(o, *t, y, b->f0);
+      if (s != SICM_SUCCESS) return s;
       b->f0_valid = 1;
     }
     if (steps >= o->max_steps) return sicm_ode_fail_max_steps(o, *t, y);
