@@ -32,7 +32,7 @@ struct LiteralFunction {
   Value base;   // the symbol it was made from
   Value head;   // what it prints as in applications: f, (D f), ((partial 0) f)
   Value domain; // Real, (X ...), (UP ...) or (DOWN ...)
-  Value range;  // Real or a structure type
+  Value range;  // Real (structure-valued ones are structures of literal functions)
   int order;    // for one real argument: how many times D was applied
   Value *path;  // for partials: the path so far (fixnums); GC memory
   size_t npath;
@@ -118,21 +118,7 @@ Value literal_apply(void *obj, Value *args, int nargs) {
   uint32_t e = 0;
   for (int i = 0; i < nargs; ++i)
     e = std::max(e, max_differential_tag(args[i]));
-  if (e == 0) {
-    if (is_pair(f->range) &&
-        (is_symbol_named(car(f->range), "UP") || is_symbol_named(car(f->range), "DOWN"))) {
-      // A structure-valued function: one literal function per component.
-      bool up = is_symbol_named(car(f->range), "UP");
-      long n = list_length(cdr(f->range));
-      Value out = make_structure(up, static_cast<size_t>(n));
-      for (long i = 0; i < n; ++i) {
-        std::string name = write_string(f->head) + "^" + std::to_string(i);
-        as_structure(out)->items[i] = symbolic_call(intern(name), args, nargs);
-      }
-      return out;
-    }
-    return symbolic_call(f->head, args, nargs);
-  }
+  if (e == 0) return symbolic_call(f->head, args, nargs);
   gcvec<Value> finite(static_cast<size_t>(nargs)), tangent(static_cast<size_t>(nargs));
   for (int i = 0; i < nargs; ++i)
     split_differential(args[i], e, &finite[i], &tangent[i]);
@@ -143,19 +129,48 @@ Value literal_apply(void *obj, Value *args, int nargs) {
   return g_add(value, times_infinitesimal(slope, e));
 }
 
+bool structure_type(Value range) {
+  return is_pair(range) &&
+         (is_symbol_named(car(range), "UP") || is_symbol_named(car(range), "DOWN"));
+}
+
+// A literal function named `name` from `domain` to `range`. As in scmutils,
+// one whose values are structures is a structure of literal functions, one
+// per component, named with the component's index: ^i for up, _i for down
+// (q^0, q^1; C^1^0, C^2_0 for nested structures), so that D, Gamma and
+// Lagrange-equations treat each component as a function of its own.
+Value literal_function_of(Value name, Value domain, Value range) {
+  if (structure_type(range)) {
+    bool up = is_symbol_named(car(range), "UP");
+    long n = list_length(cdr(range));
+    Value out = make_structure(up, static_cast<size_t>(n));
+    Value component = cdr(range);
+    for (long i = 0; i < n; ++i, component = cdr(component)) {
+      Value sub = intern(symbol_name(name) + (up ? "^" : "_") + std::to_string(i));
+      as_structure(out)->items[i] = literal_function_of(sub, domain, car(component));
+    }
+    return out;
+  }
+  LiteralFunction *lf = gc_new<LiteralFunction>();
+  lf->base = name;
+  lf->head = name;
+  lf->domain = domain;
+  lf->range = range;
+  lf->order = 0;
+  return wrap(lf);
+}
+
 // (literal-function 'f [type])
 Value P_literal_function(Value *a, int n) {
   if (!is_symbol(a[0])) wrong_type(a[0], 1, "literal-function");
   Value type = n > 1 ? a[1] : list({intern("->"), intern("Real"), intern("Real")});
   if (list_length(type) != 3 || !is_symbol_named(car(type), "->"))
     wrong_type(type, 2, "literal-function");
-  LiteralFunction *lf = gc_new<LiteralFunction>();
-  lf->base = a[0];
-  lf->head = a[0];
-  lf->domain = car(cdr(type));
-  lf->range = car(cdr(cdr(type)));
-  lf->order = 0;
-  return wrap(lf);
+  Value range = car(cdr(cdr(type)));
+  for (Value r = structure_type(range) ? cdr(range) : Value::nil(); is_pair(r); r = cdr(r))
+    if (!is_symbol_named(car(r), "Real") && !structure_type(car(r)))
+      wrong_type(type, 2, "literal-function");
+  return literal_function_of(a[0], car(cdr(type)), range);
 }
 
 Value P_literal_function_p(Value *a, int) {
