@@ -20,12 +20,13 @@ namespace sicm {
 namespace {
 
 enum class SeriesKind {
-  Exp,     // a: operator x, b: function f; powers: x^k f
-  Applied, // a: series of functions, b: argument list
-  Sum,     // a + b
-  Scale,   // coefficient a times series b
-  Product, // Cauchy product of a and b
-  Given,   // the terms listed, then zeros
+  Exp,      // a: operator x, b: function f; powers: x^k f
+  Applied,  // a: series of functions, b: argument list
+  Sum,      // a + b
+  Scale,    // coefficient a times series b
+  Product,  // Cauchy product of a and b
+  Quotient, // a / b: the series c with c b = a, term by term (b's first term not zero)
+  Given,    // the terms listed, then zeros
 };
 
 struct Series {
@@ -81,6 +82,17 @@ Value compute_term(Series *s, size_t k) {
       sum = g_add(sum, g_mul(series_term(s->a, i), series_term(s->b, k - i)));
     return sum;
   }
+  case SeriesKind::Quotient: {
+    // a_k = sum_{i <= k} b_i c_{k-i}, so c_k = (a_k - sum_{1 <= i <= k} b_i c_{k-i}) / b_0.
+    Value b0 = series_term(s->b, 0);
+    if (is_exact_zero(b0))
+      runtime_error(current_call_loc(), "Division by zero signalled by /: a series whose first "
+                                        "term is 0 has no series inverse");
+    Value rest = series_term(s->a, k);
+    for (size_t i = 1; i <= k; ++i)
+      rest = g_sub(rest, g_mul(series_term(s->b, i), s->terms[k - i]));
+    return g_div(rest, b0);
+  }
   case SeriesKind::Given: {
     long n = list_length(s->a);
     if (static_cast<long>(k) >= n) return Value::fixnum(0);
@@ -98,8 +110,14 @@ Value series_apply(void *obj, Value *args, int nargs) {
   return make_series(SeriesKind::Applied, self, list_from(args, static_cast<size_t>(nargs)));
 }
 
+Value constant_series(Value x) {
+  return make_series(SeriesKind::Given, list({x}), Value());
+}
+
 Value series_unary(UnaryOp op, Value x) {
   if (op == UnaryOp::Neg) return make_series(SeriesKind::Scale, Value::fixnum(-1), x);
+  if (op == UnaryOp::Invert)
+    return make_series(SeriesKind::Quotient, constant_series(Value::fixnum(1)), x);
   arith_wrong_type(op, x);
 }
 
@@ -116,7 +134,7 @@ Value series_binary(BinaryOp op, Value a, Value b) {
     return make_series(SeriesKind::Scale, sa ? b : a, sa ? a : b);
   case BinaryOp::Div:
     if (sa && !sb) return make_series(SeriesKind::Scale, g_unary(UnaryOp::Invert, b), a);
-    break;
+    return make_series(SeriesKind::Quotient, sa ? a : constant_series(a), b);
   default: break;
   }
   arith_wrong_type(op, sa ? b : a, sa ? 2 : 1);
