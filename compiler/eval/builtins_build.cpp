@@ -56,6 +56,7 @@
 
 #include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
+#include "codegen/state_shape.hpp"
 #include "eval/build_state.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
@@ -495,6 +496,69 @@ constexpr char kLessEq[] = "<=";
 constexpr char kGreaterEq[] = ">=";
 constexpr char kEqual[] = "=";
 
+// x and y, either possibly a run-time truth value.
+Value both(Value x, Value y, const char *who) {
+  if (!is_dynamic_boolean(x) && !is_dynamic_boolean(y))
+    return Value::boolean(x.truthy() && y.truthy());
+  if (!is_dynamic_boolean(x)) return x.truthy() ? y : x;
+  if (!is_dynamic_boolean(y)) return y.truthy() ? x : y;
+  return let(RCompute::Select, {expr_of(x, who), expr_of(y, who), expr_integer(0)}, RType::Boolean);
+}
+
+// A scalar's kind as eqv? sees it: a truth value, an exact number, an
+// inexact one.
+RType scalar_kind(Value v) {
+  if (is_dynamic_scalar(v) || is_dynamic_boolean(v)) return scalar_type(v);
+  if (v.is(Tag::Bool)) return RType::Boolean;
+  return v.is(Tag::Flonum) ? RType::Real : RType::Integer;
+}
+
+// eq?, eqv? and equal? where run-time values are compared: two numbers at
+// run time (a run-time number is never the same as anything not a number);
+// equal? also walks pairs, structures and vectors, comparing the leaves
+// pairwise. Without this the comparison would be of the expressions that
+// stand for the values, and two lists of equal run-time numbers would be
+// different at compile time.
+Value same(Value a, Value b, bool deep, const char *who) {
+  bool da = is_dynamic_scalar(a) || is_dynamic_boolean(a),
+       db = is_dynamic_scalar(b) || is_dynamic_boolean(b);
+  if (da || db) {
+    // What kind of scalar each is, is known now: eqv? of an inexact number
+    // (a run-time number is one, unless it counts) and an exact one is #f.
+    if (!is_scalar(a) || !is_scalar(b) || scalar_kind(a) != scalar_kind(b))
+      return Value::boolean(false);
+    return let(RCompute::Equal, {expr_of(a, who), expr_of(b, who)}, RType::Boolean);
+  }
+  if (!deep || (!contains_dynamic(a) && !contains_dynamic(b))) {
+    Value pair[2] = {a, b};
+    return call_original(who, pair, 2);
+  }
+  if (as_rtlist(a) || as_rtlist(b))
+    cannot_compile(here(), std::string(who) + " of a list whose length is known only at run time");
+  if (is_pair(a) || is_pair(b)) {
+    if (!is_pair(a) || !is_pair(b)) return Value::boolean(false);
+    Value first = same(car(a), car(b), deep, who);
+    if (!is_dynamic_boolean(first) && !first.truthy()) return first;
+    return both(first, same(cdr(a), cdr(b), deep, who), who);
+  }
+  size_t la = 0, lb = 0;
+  Value *x = container_items(a, &la), *y = container_items(b, &lb);
+  if (!x || !y || la != lb || a.tag != b.tag) return Value::boolean(false);
+  if (is_structure(a) && as_structure(a)->up != as_structure(b)->up) return Value::boolean(false);
+  Value result = Value::boolean(true);
+  for (size_t i = 0; i < la; ++i)
+    result = both(result, same(x[i], y[i], deep, who), who);
+  return result;
+}
+
+template <const char *Name, bool Deep> Value P_same(Value *a, int n) {
+  if (!contains_dynamic(a[0]) && !contains_dynamic(a[1])) return call_original(Name, a, n);
+  return same(a[0], a[1], Deep, Name);
+}
+constexpr char kEqP[] = "eq?";
+constexpr char kEqvP[] = "eqv?";
+constexpr char kEqualP[] = "equal?";
+
 template <const char *Name, RCompute C, bool Swap> Value P_sign_test(Value *a, int n) {
   if (!any_dynamic(a, n)) return call_original(Name, a, n);
   Value args[2] = {a[0], Value::fixnum(0)};
@@ -647,6 +711,9 @@ void begin_build_mode(ResidualProgram *program) {
   rebind("max", 1, kVariadic, P_fold<kMax, RCompute::Max>);
   rebind("min", 1, kVariadic, P_fold<kMin, RCompute::Min>);
   rebind("not", 1, 1, P_not);
+  rebind("eq?", 2, 2, P_same<kEqP, false>);
+  rebind("eqv?", 2, 2, P_same<kEqvP, false>);
+  rebind("equal?", 2, 2, P_same<kEqualP, true>);
   rebind("real-time", 0, 0, P_real_time);
   rebind("parameter", 2, 2, P_parameter);
   rebind("runtime", 0, 0, P_runtime);
