@@ -1,6 +1,7 @@
 # sicm: build, test, install, demo.
 #
-#   make            build build/sicm and build/libsicmrt.a
+#   make            build build/sicm and build/libsicmrt.a (and, when mpicc
+#                   is found, build/libsicmrt_mpi.a for sicm build --mpi)
 #   make check      install missing Debian packages, build, run every test
 #   make demo       install missing Debian packages, build, compile an example
 #                   scene with sicm build and run it (writes its SVG)
@@ -35,6 +36,9 @@ CPPFLAGS  := -Icompiler -Iruntime/include -MMD -MP
 CXXFLAGS  := -std=c++20 $(OPT) -g $(WARN) $(SANFLAGS) $(SANDEF)
 CFLAGS    := -std=c11 $(OPT) -g $(WARN) $(SANFLAGS)
 LDFLAGS   := $(SANFLAGS)
+# The MPI wrapper compiler, for libsicmrt_mpi.a (sicm build --mpi); empty
+# when Open MPI's development files are not installed, and then no MPI.
+MPICC    ?= $(shell command -v mpicc 2>/dev/null)
 LIBS      := -lflint -lgc -lgmp -lreadline -lsundials_cvode -lsundials_nvecserial -lgsl -lgslcblas -lm -lpthread -ldl
 
 # ---- sources, per component --------------------------------------------
@@ -59,9 +63,13 @@ LIB_OBJS      := $(filter-out $(BUILD)/compiler/main.o,$(COMPILER_OBJS))
 SICM    := $(BUILD)/sicm
 RTLIB   := $(BUILD)/libsicmrt.a
 UNITBIN := $(BUILD)/unit-tests
+# sicm_mpi_start and the sweeps' MPI exchange (runtime/mpi/), linked before
+# libsicmrt.a into the executables of sicm build --mpi.
+MPILIB  := $(if $(MPICC),$(BUILD)/libsicmrt_mpi.a)
+MPI_OBJS := $(if $(MPICC),$(BUILD)/runtime/mpi/parallel_mpi.o)
 
 .PHONY: all check demo examples stability accuracy effects install clean deps unit fuzz-smoke
-all: $(SICM) $(RTLIB)
+all: $(SICM) $(RTLIB) $(MPILIB)
 
 $(BUILD)/%.o: %.cpp
 	@mkdir -p $(dir $@)
@@ -88,6 +96,15 @@ $(BUILD)/runtime/src/%.o: runtime/src/%.cpp
 	$(CXX) $(CPPFLAGS) $(RTCXXFLAGS) -c $< -o $@
 
 $(RTLIB): $(RUNTIME_OBJS)
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
+
+# runtime/mpi/ needs mpi.h, which only the wrapper compiler finds.
+$(BUILD)/runtime/mpi/%.o: runtime/mpi/%.c
+	@mkdir -p $(dir $@)
+	$(MPICC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+$(BUILD)/libsicmrt_mpi.a: $(MPI_OBJS)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
 
@@ -168,9 +185,10 @@ install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/sicm
 	install -m 755 $(SICM) $(DESTDIR)$(PREFIX)/bin/sicm
 	install -m 644 $(RTLIB) $(DESTDIR)$(PREFIX)/lib/libsicmrt.a
+	$(if $(MPILIB),install -m 644 $(MPILIB) $(DESTDIR)$(PREFIX)/lib/libsicmrt_mpi.a)
 	install -m 644 runtime/include/sicm/*.h $(DESTDIR)$(PREFIX)/include/sicm/
 
 clean:
 	rm -rf $(BUILD)
 
--include $(COMPILER_OBJS:.o=.d) $(RUNTIME_OBJS:.o=.d) $(UNIT_OBJS:.o=.d)
+-include $(COMPILER_OBJS:.o=.d) $(RUNTIME_OBJS:.o=.d) $(UNIT_OBJS:.o=.d) $(MPI_OBJS:.o=.d)

@@ -44,6 +44,7 @@ struct sicm_plot {
   size_t n, cap;
   size_t unflushed;
   int closed;
+  int silent; /* sicm_plot_open_silent: no files, no marks kept */
 };
 
 static sicm_plot *open_plots[kMaxOpenPlots];
@@ -188,6 +189,20 @@ sicm_plot *sicm_plot_open(const char *dir, const char *name, const char *title, 
   return p;
 }
 
+/* A silent plot has no path and no TSV; add_point, add_line and finish_plot
+ * see its flag and only keep track of whether it is finished. */
+sicm_plot *sicm_plot_open_silent(const char *name) {
+  sicm_plot *p = calloc(1, sizeof *p);
+  if (!p) return NULL;
+  p->title = dup_string(name);
+  if (!p->title) {
+    free(p);
+    return NULL;
+  }
+  p->silent = 1;
+  return p;
+}
+
 int sicm_plot_set_labels(sicm_plot *p, const char *x_label, const char *y_label) {
   char *x = x_label ? dup_string(x_label) : NULL, *y = y_label ? dup_string(y_label) : NULL;
   if ((x_label && !x) || (y_label && !y)) {
@@ -243,7 +258,15 @@ int sicm_plot_point(sicm_plot *p, double x, double y) {
   return status;
 }
 
+/* A silent plot keeps nothing but refuses marks once finished, as a real one. */
+static int silent_mark(const sicm_plot *p) {
+  if (!p->closed) return 0;
+  errno = EINVAL;
+  return -1;
+}
+
 static int add_point(sicm_plot *p, double x, double y) {
+  if (p->silent) return silent_mark(p);
   mark m = {x, y, NAN, NAN};
   if (add_mark(p, m) != 0) return -1;
   write_tsv_number(p->tsv, x);
@@ -262,6 +285,7 @@ int sicm_plot_line(sicm_plot *p, double x0, double y0, double x1, double y1) {
 }
 
 static int add_line(sicm_plot *p, double x0, double y0, double x1, double y1) {
+  if (p->silent) return silent_mark(p);
   mark m = {x0, y0, x1, y1};
   if (add_mark(p, m) != 0) return -1;
   write_tsv_number(p->tsv, x0);
@@ -435,6 +459,7 @@ static int write_svg(const sicm_plot *p) {
 static int finish_plot(sicm_plot *p) {
   if (p->closed) return 0;
   p->closed = 1;
+  if (p->silent) return 0;
   int status = 0;
   if (fclose(p->tsv) != 0) status = -1;
   p->tsv = NULL;
@@ -467,6 +492,10 @@ void sicm_plot_free(sicm_plot *p) {
 void sicm_plot_close_all(void) {
   for (int i = 0; i < kMaxOpenPlots; ++i)
     if (open_plots[i]) finish_plot(open_plots[i]);
+}
+
+int sicm_plot_is_finished(const sicm_plot *p) {
+  return p->closed;
 }
 
 size_t sicm_plot_count(const sicm_plot *p) {

@@ -6,22 +6,43 @@
  * restarting integrators and of placing monitor times, the same relaxation
  * of an integral's tolerance. Kernels are adapted to the runtime's callback
  * types by the small functions below; the runtime's error hook records the
- * last failure message so the driver can quote it. */
+ * last failure message so the driver can quote it.
+ *
+ * Members of a parallel sweep (parallel.c) call all of this from several
+ * threads at once: what they print, plot or fail with goes to their logs
+ * (sicm_parallel_log_*), the last failure message is per thread, and the
+ * rest of the state here is written only by sicm_program_init and by frames,
+ * which members never make (the compiler runs such members serially). */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
 #include <errno.h>
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include <gsl/gsl_errno.h>
+
+#include "parallel_internal.h"
 #include "sicm/runtime.h"
 
 /* ---- options and failure --------------------------------------------------------- */
 
 static const char *plot_dir = ".";
-static char last_reason[1024];
+/* Per thread: members on the sweep's threads fail and quote their own. */
+static _Thread_local char last_reason[1024];
+/* An MPI rank other than 0 (see parallel_internal.h). */
+static int quiet;
+
+void sicm_program_set_quiet(int on) {
+  quiet = on;
+}
+
+int sicm_program_quiet(void) {
+  return quiet;
+}
 
 static void record_reason(const char *reason, int status) {
   (void)status;
@@ -41,7 +62,8 @@ static double param_values[kMaxParams];
 static int nparams;
 
 static void usage(FILE *f, const char *argv0, const char *const *parameters) {
-  fprintf(f, "usage: %s [--plot-dir DIR] [--stats]", argv0);
+  if (quiet) return;
+  fprintf(f, "usage: %s [--plot-dir DIR] [--threads N] [--stats]", argv0);
   for (const char *const *p = parameters; *p; ++p)
     fprintf(f, " [--param %s=VALUE]", *p);
   fputc('\n', f);
@@ -64,8 +86,18 @@ static int set_param(const char *assignment, const char *const *parameters) {
   return 0;
 }
 
+/* --threads N: a whole number from 1 to 65536; 0 for anything else. */
+static int thread_count(const char *text) {
+  char *end;
+  errno = 0;
+  long n = strtol(text, &end, 10);
+  if (errno != 0 || end == text || *end != '\0' || n < 1 || n > 65536) return 0;
+  return (int)n;
+}
+
 /* --stats: after the run (or a failure), what each integration site cost. */
 static void print_stats(void) {
+  if (quiet) return;
   fflush(stdout);
   sicm_stats_print(stderr);
 }
@@ -75,21 +107,35 @@ void sicm_program_init(int argc, char **argv, const char *program_name,
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--plot-dir") == 0 && i + 1 < argc) {
       plot_dir = argv[++i];
+    } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+      int n = thread_count(argv[++i]);
+      if (n == 0) {
+        if (!quiet)
+          fprintf(stderr, "%s: --threads %s: not a whole number of threads from 1 to 65536\n",
+                  argv[0], argv[i]);
+        usage(stderr, argv[0], parameters);
+        exit(64);
+      }
+      sicm_parallel_set_threads(n);
     } else if (strcmp(argv[i], "--stats") == 0) {
       if (!sicm_stats_enabled()) atexit(print_stats);
       sicm_stats_enable();
     } else if (strcmp(argv[i], "--param") == 0 && i + 1 < argc) {
       if (!set_param(argv[++i], parameters)) {
-        fprintf(stderr, "%s: --param %s: not NAME=NUMBER for a parameter of the program\n", argv[0],
-                argv[i]);
+        if (!quiet)
+          fprintf(stderr, "%s: --param %s: not NAME=NUMBER for a parameter of the program\n",
+                  argv[0], argv[i]);
         usage(stderr, argv[0], parameters);
         exit(64);
       }
     } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
       usage(stdout, argv[0], parameters);
-      printf("  a program compiled by sicm build from %s; plots go to DIR (default .);\n"
-             "  --stats prints what each integration cost on stderr after the run\n",
-             program_name);
+      if (!quiet)
+        printf("  a program compiled by sicm build from %s; plots go to DIR (default .);\n"
+               "  --threads N runs the members of parallel-map and parallel-for-each on N\n"
+               "  threads (default: the cores this process may run on);\n"
+               "  --stats prints what each integration cost on stderr after the run\n",
+               program_name);
       exit(0);
     } else {
       usage(stderr, argv[0], parameters);
@@ -97,6 +143,10 @@ void sicm_program_init(int argc, char **argv, const char *program_name,
     }
   }
   sicm_set_error_handler(record_reason);
+  /* The runtime switches GSL's handler off and back around each call; from
+   * several threads that would hand back GSL's aborting default while
+   * another thread is inside GSL, unless it is off from the start. */
+  gsl_set_error_handler_off();
 }
 
 double sicm_program_param(const char *name, double fallback) {
@@ -105,37 +155,82 @@ double sicm_program_param(const char *name, double fallback) {
   return fallback;
 }
 
-void sicm_program_fail(const sicm_site *site, const char *who, const char *reason) {
-  fflush(stdout);
-  fprintf(stderr, "%s: error: %s: %s\n", site->where, who, reason);
+/* The failure's whole message, as it goes to stderr: "WHERE: error: WHO:
+ * REASON", the source line and a caret under the call. malloc'd; NULL if
+ * memory runs out. */
+static char *failure_text(const sicm_site *site, const char *who, const char *reason) {
+  char *text = NULL;
+  size_t size = 0;
+  FILE *f = open_memstream(&text, &size);
+  if (!f) return NULL;
+  fprintf(f, "%s: error: %s: %s\n", site->where, who, reason);
   if (site->line && site->line[0]) {
-    fprintf(stderr, "  %s\n  ", site->line);
+    fprintf(f, "  %s\n  ", site->line);
     for (int i = 1; i < site->col; ++i)
-      fputc(site->line[i - 1] == '\t' ? '\t' : ' ', stderr);
-    fputs("^\n", stderr);
+      fputc(site->line[i - 1] == '\t' ? '\t' : ' ', f);
+    fputs("^\n", f);
   }
+  if (fclose(f) != 0) {
+    free(text);
+    return NULL;
+  }
+  return text;
+}
+
+/* The end of every failure: the plots finished, then status 70. */
+_Noreturn static void exit_failed(void) {
   sicm_plot_close_all();
+  sicm_parallel_failing();
   exit(70);
+}
+
+void sicm_program_fail_message(const char *message) {
+  fflush(stdout);
+  if (!quiet) fputs(message ? message : "error: out of memory\n", stderr);
+  exit_failed();
+}
+
+void sicm_program_fail(const sicm_site *site, const char *who, const char *reason) {
+  char *message = failure_text(site, who, reason);
+  sicm_parallel_member_failed(message); /* in a member: its log takes it, and no return */
+  if (!message) {
+    /* No memory for the text: write it piece by piece. */
+    fflush(stdout);
+    if (!quiet) fprintf(stderr, "%s: error: %s: %s\n", site->where, who, reason);
+    exit_failed();
+  }
+  sicm_program_fail_message(message);
 }
 
 /* ---- printing --------------------------------------------------------------------- */
 
+void sicm_program_write(const char *s, size_t len) {
+  if (!quiet) fwrite(s, 1, len, stdout);
+}
+
+/* Every print: to the running member's log, or to stdout. */
+static void print(const char *s, size_t len) {
+  if (!sicm_parallel_log_text(s, len)) sicm_program_write(s, len);
+}
+
 void sicm_print_text(const char *s) {
-  fputs(s, stdout);
+  print(s, strlen(s));
 }
 
 void sicm_print_real(double x) {
   char buf[SICM_DOUBLE_BUFSIZE];
-  sicm_format_double(buf, x);
-  fputs(buf, stdout);
+  print(buf, sicm_format_double(buf, x));
 }
 
 void sicm_print_integer(double x) {
-  printf("%.0f", x);
+  /* An integral double has at most 309 digits and a sign. */
+  char buf[320];
+  int len = snprintf(buf, sizeof buf, "%.0f", x);
+  print(buf, len < 0 ? 0 : (size_t)len < sizeof buf ? (size_t)len : sizeof buf - 1);
 }
 
 void sicm_print_boolean(double x) {
-  fputs(x != 0 ? "#t" : "#f", stdout);
+  print(x != 0 ? "#t" : "#f", 2);
 }
 
 double sicm_real_time(void) {
@@ -150,15 +245,46 @@ double sicm_run_time(void) {
 
 /* ---- plots ------------------------------------------------------------------------- */
 
+/* Every frame made, in order (see sicm_program_frame_number). */
+static sicm_plot **frames;
+static size_t nframes, frames_cap;
+
+static void remember_frame(const sicm_site *site, sicm_plot *p) {
+  if (nframes == frames_cap) {
+    size_t cap = frames_cap ? 2 * frames_cap : 16;
+    sicm_plot **grown = realloc(frames, cap * sizeof *grown);
+    if (!grown) sicm_program_fail(site, "frame", "out of memory");
+    frames = grown;
+    frames_cap = cap;
+  }
+  frames[nframes++] = p;
+}
+
+size_t sicm_program_frame_number(const sicm_plot *plot) {
+  for (size_t i = nframes; i-- > 0;) /* the latest frames are the likeliest */
+    if (frames[i] == plot) return i;
+  return SIZE_MAX;
+}
+
+sicm_plot *sicm_program_frame_at(size_t number) {
+  return number < nframes ? frames[number] : NULL;
+}
+
 sicm_plot *sicm_program_frame(const sicm_site *site, const char *name, const char *title,
                               double xmin, double xmax, double ymin, double ymax) {
-  sicm_plot *p = sicm_plot_open(plot_dir, name, title, xmin, xmax, ymin, ymax);
-  if (!p) {
+  /* Under MPI rank 0 writes the files and the other ranks' frames only take
+   * the calls; when rank 0 cannot create its files, every rank fails, as
+   * rank 0 does, rather than going on alone. */
+  sicm_plot *p = quiet ? sicm_plot_open_silent(name)
+                       : sicm_plot_open(plot_dir, name, title, xmin, xmax, ymin, ymax);
+  const int error = errno;
+  if (!sicm_parallel_rank0_value(p != NULL) || !p) {
     char reason[512];
     snprintf(reason, sizeof reason, "cannot create the plot file %s/%s.tsv: %s", plot_dir, name,
-             strerror(errno));
+             strerror(error));
     sicm_program_fail(site, "frame", reason);
   }
+  remember_frame(site, p);
   return p;
 }
 
@@ -168,15 +294,25 @@ void sicm_program_plot_labels(const sicm_site *site, sicm_plot *plot, const char
     sicm_program_fail(site, "frame", "out of memory");
 }
 
+/* A mark on a finished plot fails in the member, where the serial run fails
+ * (in the interpreter's words, which cover both causes). */
+static const char mark_refused[] = "the plot is closed or memory is exhausted";
+
+static void check_open(const sicm_site *site, const sicm_plot *plot, const char *who) {
+  if (sicm_plot_is_finished(plot)) sicm_program_fail(site, who, mark_refused);
+}
+
 void sicm_program_plot_point(const sicm_site *site, sicm_plot *plot, double x, double y) {
-  if (sicm_plot_point(plot, x, y) != 0)
-    sicm_program_fail(site, "plot-point", "the plot is closed or memory is exhausted");
+  check_open(site, plot, "plot-point");
+  if (sicm_parallel_log_point(plot, x, y)) return;
+  if (sicm_plot_point(plot, x, y) != 0) sicm_program_fail(site, "plot-point", mark_refused);
 }
 
 void sicm_program_plot_line(const sicm_site *site, sicm_plot *plot, double x0, double y0, double x1,
                             double y1) {
-  if (sicm_plot_line(plot, x0, y0, x1, y1) != 0)
-    sicm_program_fail(site, "plot-line", "the plot is closed or memory is exhausted");
+  check_open(site, plot, "plot-line");
+  if (sicm_parallel_log_line(plot, x0, y0, x1, y1)) return;
+  if (sicm_plot_line(plot, x0, y0, x1, y1) != 0) sicm_program_fail(site, "plot-line", mark_refused);
 }
 
 /* ---- kernels as the runtime's callbacks -------------------------------------------- */

@@ -1,5 +1,10 @@
-/* Per-site integration statistics for --stats (see sicm/stats.h). */
+/* Per-site integration statistics for --stats (see sicm/stats.h).
+ *
+ * The members of a parallel sweep integrate on several threads at once, so
+ * the record is behind a mutex; sicm_stats_enable is called before any
+ * sweep (by sicm_program_init), so the flag itself needs none. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime, strdup */
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -17,6 +22,7 @@ typedef struct {
 static int enabled;
 static site_line *lines;
 static size_t nlines, capacity;
+static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 
 void sicm_stats_enable(void) {
   enabled = 1;
@@ -58,17 +64,20 @@ static site_line *line_of(const char *where, const char *who, const char *method
 void sicm_stats_add(const char *where, const char *who, const char *method, double tolerance,
                     const sicm_ode_stats *work, double seconds) {
   if (!enabled) return;
+  pthread_mutex_lock(&lock);
   site_line *l = line_of(where ? where : "?", who ? who : "?", method ? method : "?", tolerance);
-  if (!l) return; /* out of memory: the statistics are a convenience */
-  l->calls++;
-  l->work.steps += work->steps;
-  l->work.rejected_steps += work->rejected_steps;
-  l->work.rhs_evals += work->rhs_evals;
-  l->work.jacobian_evals += work->jacobian_evals;
-  l->seconds += seconds;
+  if (l) { /* out of memory, nothing: the statistics are a convenience */
+    l->calls++;
+    l->work.steps += work->steps;
+    l->work.rejected_steps += work->rejected_steps;
+    l->work.rhs_evals += work->rhs_evals;
+    l->work.jacobian_evals += work->jacobian_evals;
+    l->seconds += seconds;
+  }
+  pthread_mutex_unlock(&lock);
 }
 
-void sicm_stats_print(FILE *f) {
+static void print_lines(FILE *f) {
   if (nlines == 0) return;
   fputs("integration statistics (--stats), one line per site, method and tolerance:\n", f);
   for (size_t i = 0; i < nlines; i++) {
@@ -85,4 +94,10 @@ void sicm_stats_print(FILE *f) {
             l->where, l->who, l->method, tol, l->calls, l->calls == 1 ? "" : "s", l->work.steps,
             l->work.rejected_steps, l->work.rhs_evals, secs);
   }
+}
+
+void sicm_stats_print(FILE *f) {
+  pthread_mutex_lock(&lock);
+  print_lines(f);
+  pthread_mutex_unlock(&lock);
 }

@@ -47,9 +47,10 @@ typedef struct {
 
 /* sicm_program_init reads the executable's options (--plot-dir DIR,
  * --param NAME=VALUE for each NAME of the NULL-terminated `parameters`,
- * --help), exiting with status 64 and a usage line for anything else, and
- * arranges for plots to be finished at exit and on SIGINT/SIGTERM. Call
- * first. */
+ * --threads N for sweeps, a whole number from 1 to 65536, --stats, --help),
+ * exiting with status 64 and a usage line for anything else, and arranges
+ * for plots to be finished at exit and on SIGINT/SIGTERM. Call first (after
+ * sicm_mpi_start in an MPI program). */
 void sicm_program_init(int argc, char **argv, const char *program_name,
                        const char *const *parameters);
 
@@ -58,7 +59,9 @@ void sicm_program_init(int argc, char **argv, const char *program_name,
 double sicm_program_param(const char *name, double fallback);
 
 /* sicm_program_fail prints "WHERE: error: WHO: REASON", the source line and
- * a caret on stderr, finishes every plot and exits with status 70. */
+ * a caret on stderr, finishes every plot and exits with status 70. Inside a
+ * member of a parallel sweep it ends the member instead, and the sweep
+ * reports it in its turn (see sicm_parallel_map). */
 void sicm_program_fail(const sicm_site *site, const char *who, const char *reason)
 #if defined(__GNUC__)
     __attribute__((noreturn))
@@ -154,6 +157,53 @@ void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double
  * state. */
 void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure monitor,
                        double *y, double dt, double t_final);
+
+/* ---- parallel-map and parallel-for-each (parallel.c) ----
+ *
+ * sicm_parallel_map runs n members; member i calls
+ *   fns[nfns == 1 ? 0 : i].fn(in + i * in_width, out + i * out_width, fns[...].p)
+ * (a NULL in when in_width is 0, a NULL out when out_width is 0). Members
+ * run on the program's threads (--threads N, default: the cores this process
+ * may run on) and, in a program built with --mpi and started under mpirun,
+ * across ranks (member i on rank i % size); the outputs of all members end
+ * up in out[] on every rank. What a member prints (sicm_print_*) and the
+ * marks it plots (sicm_program_plot_point, sicm_program_plot_line) are kept
+ * per member and emitted in member order after the members have run, so
+ * stdout and the plot files are byte-identical to a serial run whatever the
+ * threads and ranks.
+ *
+ * serial != 0: the members run one after another on the calling thread,
+ * unbuffered (the compiler says so when members touch the program's
+ * globals: cells, run-time lists, frames). So do the members of a sweep on
+ * one thread and one rank, which is a serial run.
+ *
+ * A member that fails (sicm_program_fail) stops the sweep: members after it
+ * are not started, what the members before it printed and plotted is
+ * emitted, then what it did itself, then its error is reported as
+ * sicm_program_fail reports it, exit status 70 (on every rank).
+ *
+ * Called inside a member (a nested sweep), the members run in order on the
+ * member's thread, into the member's log.
+ *
+ * On a terminal, a sweep that has run for more than a second shows
+ * "parallel-map: K/N members" on stderr (rank 0, K of its N members done),
+ * erased when it ends. */
+void sicm_parallel_map(const sicm_site *site, const sicm_closure *fns, size_t nfns, size_t n,
+                       const double *in, size_t in_width, double *out, size_t out_width,
+                       int serial);
+
+/* The number of threads sweeps use (--threads; n below 1 means 1), and the
+ * number in force (the cores this process may run on until set). */
+void sicm_parallel_set_threads(int n);
+int sicm_parallel_threads(void);
+
+/* Programs built with --mpi call this first, before sicm_program_init:
+ * MPI_Init (MPI_Init_thread, funneled: only the calling thread calls MPI),
+ * MPI_Finalize at exit (a normal exit and a failure's exit 70 alike), and
+ * every rank but 0 stays quiet: it prints nothing, writes no plot file and,
+ * on a failure, exits with the same status without a message. Defined only
+ * in libsicmrt_mpi.a (runtime/mpi/), linked before libsicmrt.a. */
+void sicm_mpi_start(int *argc, char ***argv);
 
 /* ---- lists whose length is known only at run time (list.c) ----
  *

@@ -59,11 +59,18 @@ typedef struct sicm_plot sicm_plot;
  * why (EINVAL for an empty range; mkdir's or fopen's reason otherwise). */
 sicm_plot *sicm_plot_open(const char *dir, const char *name, const char *title, double xmin,
                           double xmax, double ymin, double ymax);
+/* A plot that writes no file and keeps no mark, for the MPI ranks that stay
+ * quiet (every rank but 0): it takes every call a plot takes, and refuses
+ * marks once finished, as a real plot does, so the quiet ranks fail where
+ * rank 0 fails. name is its title. NULL if memory runs out. */
+sicm_plot *sicm_plot_open_silent(const char *name);
 /* Label the axes (either NULL for none): x_label under the x axis, y_label
  * beside the y axis, written into the SVG. */
 int sicm_plot_set_labels(sicm_plot *p, const char *x_label, const char *y_label);
 int sicm_plot_point(sicm_plot *p, double x, double y);
 int sicm_plot_line(sicm_plot *p, double x0, double y0, double x1, double y1);
+/* Whether the plot has been finished (its marks are refused). */
+int sicm_plot_is_finished(const sicm_plot *p);
 /* Number of marks (points and segments) added so far. */
 size_t sicm_plot_count(const sicm_plot *p);
 /* Write the SVG and close the TSV; later marks are refused. Idempotent. */
