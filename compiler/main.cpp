@@ -63,9 +63,11 @@ const char kUsage[] =
     "                            prints what each integration cost on stderr (so\n"
     "                            do built programs given --stats)\n"
     "       sicm build FILE [-o EXE] [-O0|-O1|-O2|-O3] [--keep-c] [--report[=PATH]]\n"
-    "                  [--fix NAME=VALUE ...]\n"
+    "                  [--fix NAME=VALUE ...] [--mpi]\n"
     "                            compile to an executable (default: FILE without\n"
-    "                            .sicm); --keep-c leaves the C as EXE.c\n"
+    "                            .sicm); --keep-c leaves the C as EXE.c; --mpi links\n"
+    "                            Open MPI: under mpirun, parallel-map's members are\n"
+    "                            spread over the ranks\n"
     "                            --report[=PATH] also writes what each kernel\n"
     "                            computes, as JSON (default PATH: EXE.report.json);\n"
     "                            --fix makes (parameter 'NAME ...) the constant VALUE\n"
@@ -282,6 +284,8 @@ int dispatch(const std::vector<std::string> &args) {
         o.opt_level = a;
       } else if (a == "--keep-c" && cmd == "build") {
         o.keep_c = true;
+      } else if (a == "--mpi" && cmd == "build") {
+        o.mpi = true;
       } else if (o.input.empty() && a.rfind("-", 0) != 0) {
         o.input = a;
       } else {

@@ -163,12 +163,32 @@ int build_program(const BuildOptions &o) {
     }
   }
   std::vector<std::string> argv = compiler_command();
+  std::vector<std::string> mpi_flags;
+  if (o.mpi) {
+    // Open MPI's wrapper compiler adds its headers and libraries to the
+    // C compiler the user chose ($CC is passed on as OMPI_CC).
+    std::string mpi_library = dir_of(library) + "/libsicmrt_mpi.a";
+    if (!exists(mpi_library)) {
+      std::fprintf(stderr,
+                   "sicm: error: --mpi: this sicm was built without MPI (%s is missing); install "
+                   "libopenmpi-dev and rebuild sicm\n",
+                   mpi_library.c_str());
+      if (!keep) std::remove(c_path.c_str());
+      return kExitCantCreat;
+    }
+    const char *mpicc = std::getenv("SICM_MPICC");
+    if (const char *cc = std::getenv("CC")) setenv("OMPI_CC", cc, 0);
+    argv = {mpicc && *mpicc ? mpicc : "mpicc"};
+    mpi_flags = {"-DSICM_MPI", mpi_library};
+  }
   // The generated C never needs to shadow a name: a declaration that hides a
   // hoisted variable once made a built program print 0. where sicm run
   // printed the value. -Werror=shadow makes such a bug fail the build.
   argv.insert(argv.end(), {"-std=c11", "-Werror=shadow", o.opt_level, "-o", o.output, c_path,
-                           "-I" + include_dir, library, "-lsundials_cvode", "-lsundials_nvecserial",
-                           "-lgsl", "-lgslcblas", "-lm"});
+                           "-I" + include_dir});
+  argv.insert(argv.end(), mpi_flags.begin(), mpi_flags.end());
+  argv.insert(argv.end(), {library, "-lsundials_cvode", "-lsundials_nvecserial", "-lgsl",
+                           "-lgslcblas", "-lm", "-lpthread"});
   std::vector<std::string> sanitize = sanitizer_flags();
   argv.insert(argv.begin() + 1, sanitize.begin(), sanitize.end());
   int status = run(argv);

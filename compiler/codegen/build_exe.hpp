@@ -16,6 +16,7 @@ struct BuildOptions {
   std::string output; // the executable; empty for emit-c
   std::string opt_level = "-O2";
   bool keep_c = false;      // leave OUTPUT.c beside the executable
+  bool mpi = false;         // compile with mpicc against libsicmrt_mpi.a (see sicm_mpi_start)
   bool emit_only = false;   // print the C on stdout instead of compiling
   bool report_only = false; // sicm report: print the kernels' table, write report_path
   std::string report_path;  // where to write the kernels' JSON (kernel_report.hpp); empty: none

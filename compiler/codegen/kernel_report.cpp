@@ -126,6 +126,8 @@ void find_uses(const std::vector<RStmt> &body, std::map<int, Use> &uses) {
     case RKind::Bisect: note(s.callee, "other"); break;
     default: break;
     }
+    for (int member : s.members)
+      note(member, "other"); // a member of parallel-map
     note(s.monitor, "monitor");
     note(s.jacobian, "jacobian");
     note(s.probe, "other"); // what the derivative divides by, evaluated only on failure

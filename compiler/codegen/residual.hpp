@@ -67,29 +67,32 @@ enum class RCompute : uint8_t {
 };
 
 enum class RKind : uint8_t {
-  Text,      // print `text`
-  Let,       // var = compute(args)
-  Print,     // print var (by its type)
-  Frame,     // plot `plot` = frame(args[0..3]) named `text`, titled `title`, axis_labels
-  PlotPoint, // plot-point plot args[0] args[1]
-  PlotLine,  // plot-line plot args[0..3]
-  Close,     // graphics-close plot
-  SetCell,   // cell `cell` = args[0]
-  If,        // if (args[0] != 0) then_body else else_body
-  Loop,      // loop variables outs = args; repeat then_body (which ends in Break or Continue)
-  Continue,  // next iteration with loop variables outs = args
-  Break,     // leave the loop with results = args
-  Integral,  // outs[0] = integral of callee over [args[0], args[1]], tolerance number
-  Minimize,  // outs[0..2] = Brent on callee over [args[0], args[1]], tolerance number
-  Multimin,  // outs = Nelder-Mead of callee from args, tolerance number
-  FindRoot,  // outs[0] = root of callee in [args[0], args[1]], tolerance number
-  Bisect,    // outs[0] = root of callee between args[0], args[1] to args[2]; number n-break
-  Advance,   // outs = state args advanced by args.back() (dt); callee the derivative
-  Evolve,    // outs = final state from args[0..dim) with monitor; dt t_final at the end
-  ListNew,   // list `list` = the empty list
-  ListPush,  // add args (an element's leaves) to list `list`
-  ListConst, // list `list` = the elements of the constant table `leaf`
-  Fail,      // never reached at compile time; unused for now
+  Text,        // print `text`
+  Let,         // var = compute(args)
+  Print,       // print var (by its type)
+  Frame,       // plot `plot` = frame(args[0..3]) named `text`, titled `title`, axis_labels
+  PlotPoint,   // plot-point plot args[0] args[1]
+  PlotLine,    // plot-line plot args[0..3]
+  Close,       // graphics-close plot
+  SetCell,     // cell `cell` = args[0]
+  If,          // if (args[0] != 0) then_body else else_body
+  Loop,        // loop variables outs = args; repeat then_body (which ends in Break or Continue)
+  Continue,    // next iteration with loop variables outs = args
+  Break,       // leave the loop with results = args
+  Integral,    // outs[0] = integral of callee over [args[0], args[1]], tolerance number
+  Minimize,    // outs[0..2] = Brent on callee over [args[0], args[1]], tolerance number
+  Multimin,    // outs = Nelder-Mead of callee from args, tolerance number
+  FindRoot,    // outs[0] = root of callee in [args[0], args[1]], tolerance number
+  Bisect,      // outs[0] = root of callee between args[0], args[1] to args[2]; number n-break
+  Advance,     // outs = state args advanced by args.back() (dt); callee the derivative
+  Evolve,      // outs = final state from args[0..dim) with monitor; dt t_final at the end
+  ListNew,     // list `list` = the empty list
+  ListPush,    // add args (an element's leaves) to list `list`
+  ListConst,   // list `list` = the elements of the constant table `leaf`
+  ParallelMap, // parallel-map: member i is function members[i] (or members[0] for all) applied
+               // to args[i*w .. i*w+w) (w = args / count); its outputs are the next ones of
+               // outs, member by member (sicm_parallel_map runs them on threads and ranks)
+  Fail,        // never reached at compile time; unused for now
 };
 
 struct RStmt {
@@ -103,6 +106,8 @@ struct RStmt {
   int plot = -1;            // plot statements: the plot's number
   int callee = -1;          // the function a numerical statement calls
   int monitor = -1;         // Evolve: the monitor function, or -1
+  std::vector<int> members; // ParallelMap: the members' functions (one for all, or one each)
+  int count = 0;            // ParallelMap: the number of members
   int jacobian = -1;        // Advance, Evolve: (D sysder) for implicit methods
   int probe = -1;           // Advance, Evolve: what sysder divides by, or -1
   int cell = -1;            // SetCell, Let of ReadCell

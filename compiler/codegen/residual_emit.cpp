@@ -105,6 +105,7 @@ public:
       out += c_string_literal(name) + ", ";
     out += "NULL};\n\n";
     out += "int main(int argc, char **argv) {\n";
+    out += "#ifdef SICM_MPI\n  sicm_mpi_start(&argc, &argv);\n#endif\n";
     out +=
         "  sicm_program_init(argc, argv, " + c_string_literal(p_.source_name) + ", parameters);\n";
     out += main_body;
@@ -220,6 +221,8 @@ private:
         refs_of(a, &s, needs);
       for (int callee : {s.callee, s.monitor, s.jacobian, s.probe})
         if (callee >= 0) needs.insert(captures_[callee].begin(), captures_[callee].end());
+      for (int member : s.members)
+        needs.insert(captures_[member].begin(), captures_[member].end());
       live.insert(needs.begin(), needs.end());
       used.insert(needs.begin(), needs.end());
     }
@@ -535,6 +538,7 @@ private:
       code += unpack(f, s.outs, y);
       break;
     }
+    case RKind::ParallelMap: code += parallel_map(f, s, prefix, args()); break;
     case RKind::If:
     case RKind::Loop: break; // written by block()
     case RKind::Continue: {
@@ -554,6 +558,71 @@ private:
     case RKind::Fail: break;
     }
     return code;
+  }
+
+  // A parallel-map: the members' closures, their inputs and room for their
+  // outputs, one call of the runtime, then the outputs unpacked member by
+  // member (each member's function has its own number of outputs).
+  std::string parallel_map(int f, const RStmt &s, const std::string &prefix,
+                           const std::vector<std::string> &a) {
+    size_t n = static_cast<size_t>(s.count), width = n ? a.size() / n : 0, out_width = 0;
+    for (int m : s.members)
+      out_width = std::max(out_width, p_.functions[m].outputs.size());
+    std::string code = "const sicm_closure " + prefix + "members[] = {";
+    for (size_t i = 0; i < s.members.size(); ++i)
+      code += (i ? ", " : "") + closure(s.members[i]);
+    code += "};\n";
+    std::string in = "NULL", out = "NULL";
+    if (!a.empty()) {
+      in = prefix + "in";
+      code += "const double " + in + "[] = {" + join(a) + "};\n";
+    }
+    if (out_width > 0) {
+      out = prefix + "out";
+      code += "double " + out + "[" + std::to_string(n * out_width) + "];\n";
+    }
+    code += "sicm_parallel_map(" + site(s.loc) + ", " + prefix + "members, " +
+            std::to_string(s.members.size()) + ", " + std::to_string(n) + ", " + in + ", " +
+            std::to_string(width) + ", " + out + ", " + std::to_string(out_width) + ", " +
+            (members_touch_globals(s.members) ? "1" : "0") + ");\n";
+    size_t k = 0;
+    for (size_t i = 0; i < n; ++i) {
+      int m = s.members[s.members.size() == 1 ? 0 : i];
+      for (size_t j = 0; j < p_.functions[m].outputs.size(); ++j, ++k)
+        if (used_[f].count(s.outs[k]))
+          code +=
+              decl(f, s.outs[k]) + " = " + out + "[" + std::to_string(i * out_width + j) + "];\n";
+    }
+    return code;
+  }
+
+  // Do the members (or the functions they call) assign the program's cells,
+  // build its run-time lists or open and close plots? Those are C globals:
+  // such members run one after another, on the calling thread.
+  bool members_touch_globals(const std::vector<int> &members) {
+    std::set<int> inside(members.begin(), members.end());
+    for (size_t g = 0; g < p_.functions.size(); ++g)
+      for (int a = p_.functions[g].parent; a >= 0; a = p_.functions[a].parent)
+        if (inside.count(a)) inside.insert(static_cast<int>(g));
+    for (int g : inside)
+      if (touches_globals(p_.functions[g].body)) return true;
+    return false;
+  }
+
+  static bool touches_globals(const std::vector<RStmt> &body) {
+    for (const RStmt &s : body) {
+      switch (s.kind) {
+      case RKind::SetCell:
+      case RKind::ListNew:
+      case RKind::ListPush:
+      case RKind::ListConst:
+      case RKind::Frame:
+      case RKind::Close: return true;
+      default: break;
+      }
+      if (touches_globals(s.then_body) || touches_globals(s.else_body)) return true;
+    }
+    return false;
   }
 
   static std::string join(const std::vector<std::string> &xs) {

@@ -512,6 +512,8 @@ void keep_trial(std::vector<RStmt> &block, const gcvec<Assignment> &assigned) {
   }
 }
 
+} // namespace
+
 // Does applying f to args record run-time work (statements other than
 // output text, or a run-time result)? Evaluated and forgotten; false if it
 // fails (it fails again, where the caller evaluates it for real).
@@ -533,6 +535,31 @@ bool does_run_time_work(Value f, gcvec<Value> args) {
   trial.roll_back();
   return work;
 }
+
+bool tentatively(const std::function<bool()> &body) {
+  std::vector<RStmt> block;
+  gcvec<Assignment> assigned;
+  {
+    Trial trial(&block);
+    try {
+      if (!body()) {
+        trial.roll_back();
+        return false;
+      }
+      assigned = trial.log();
+    } catch (const Error &) {
+      trial.roll_back();
+      return false;
+    } catch (...) {
+      trial.roll_back();
+      throw;
+    }
+  }
+  keep_trial(block, assigned);
+  return true;
+}
+
+namespace {
 
 // An element a constant table can hold: an inexact number, or a pair or
 // up/down structure of such elements (a list of them ends in ()).
@@ -618,28 +645,14 @@ bool map_over_static_lists(Value *a, int n, bool collect, const char *who, Value
     firsts.push_back(car(a[k]));
   }
   if (!does_run_time_work(a[0], firsts)) return false;
-  std::vector<RStmt> block;
-  Value v;
-  gcvec<Assignment> assigned;
-  {
-    Trial trial(&block);
-    try {
-      gcvec<Value> views;
-      for (size_t k = 0; k < shapes.size(); ++k)
-        views.push_back(constant_list(shapes[k], std::move(tables[k]), count, who));
-      v = map_over_lists(a[0], views.data(), n - 1, collect, who);
-      assigned = trial.log();
-    } catch (const Error &) {
-      trial.roll_back();
-      return false; // unrolled: the error, if real, comes again
-    } catch (...) {
-      trial.roll_back();
-      throw;
-    }
-  }
-  keep_trial(block, assigned);
-  *out = v;
-  return true;
+  // If it cannot be compiled as a loop it is unrolled: the error, if real, comes again.
+  return tentatively([&] {
+    gcvec<Value> views;
+    for (size_t k = 0; k < shapes.size(); ++k)
+      views.push_back(constant_list(shapes[k], std::move(tables[k]), count, who));
+    *out = map_over_lists(a[0], views.data(), n - 1, collect, who);
+    return true;
+  });
 }
 
 // ---- loops that start from known values -------------------------------------------------

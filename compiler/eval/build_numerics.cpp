@@ -69,6 +69,8 @@ private:
   gcvec<Value> saved_lists_; // the list cells' variables
 };
 
+} // namespace
+
 // A value shaped like `sample` (a number, or an up/down structure of them)
 // whose leaves are fresh inputs of the current function.
 Value input_like(Value sample) {
@@ -110,6 +112,14 @@ std::string procedure_name(Value proc) {
     return proc.as<Closure>()->lambda->name->name;
   return "anonymous";
 }
+
+int in_new_function(const std::string &name, const std::function<void()> &body) {
+  FunctionScope scope(name);
+  body();
+  return scope.id();
+}
+
+namespace {
 
 // Trace a scalar function (integrand, objective, function with a root).
 int trace_scalar(Value f, const char *who) {

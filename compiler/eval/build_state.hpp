@@ -121,6 +121,7 @@ void rebind(const char *name, int min, int max, PrimFn fn);
 void rebind_numerical_primitives(); // build_numerics.cpp
 void rebind_plot_primitives();      // build_plots.cpp
 void rebind_list_primitives();      // build_lists.cpp
+void rebind_parallel_primitives();  // build_parallel.cpp
 
 // ---- branches on run-time values (build_branches.cpp) -------------------------------------
 
@@ -149,6 +150,21 @@ Value hook_logic(Value test, Node *n, uint32_t from, bool is_and, Frame *env);
 Value hook_set_global(Symbol *s, Value v, SrcLoc loc);
 Value hook_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc);
 
+// ---- procedures traced into functions (build_numerics.cpp) ----------------------------
+
+// Run `body` with a new function of the residual program open (named `name`,
+// a child of the open one): the statements it causes go to the new
+// function's body, and the cells and list variables are as the caller sees
+// them again afterwards. Returns the function's id.
+int in_new_function(const std::string &name, const std::function<void()> &body);
+// A value shaped like `sample` (a number, or an up/down structure of them)
+// whose leaves are fresh inputs of the open function.
+Value input_like(Value sample);
+// Is v a number, a run-time scalar, or an up/down structure of them?
+bool is_state_shape(Value v);
+// The name of a closure's lambda, or "anonymous".
+std::string procedure_name(Value proc);
+
 // ---- loops (build_loops.cpp) --------------------------------------------------------------
 
 struct LoopRetry {}; // evaluate the loop's body again with more loop variables
@@ -175,6 +191,13 @@ bool grows_in_loop(Frame *frame);
 // (map f l ...) or (for-each f l ...) over lists known at compile time as a
 // C loop, past --max-unrolled-elements; false to unroll it.
 bool map_over_static_lists(Value *a, int n, bool collect, const char *who, Value *out);
+// Does applying f to args record run-time work (statements other than
+// output text, or a run-time result)? Evaluated and forgotten.
+bool does_run_time_work(Value f, gcvec<Value> args);
+// Evaluate `body` tentatively: what it made is kept if it returns true, and
+// forgotten (variables, functions, lists, tables, statements, assignments)
+// if it returns false or raises an Error, which is then swallowed.
+bool tentatively(const std::function<bool()> &body);
 // The evaluator's hook for calls of closures.
 bool hook_call_closure(Value f, Value *slots, long n, Value *out);
 

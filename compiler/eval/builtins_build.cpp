@@ -732,6 +732,7 @@ void begin_build_mode(ResidualProgram *program) {
   rebind_plot_primitives();
 
   rebind_list_primitives();
+  rebind_parallel_primitives();
 
   set_output_hook(residual_output);
   set_print_preparer(prepare_toplevel);

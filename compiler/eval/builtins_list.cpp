@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "eval/captured_assignment.hpp"
 #include "eval/core.hpp"
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
@@ -286,6 +287,19 @@ Value P_map(Value *a, int n) {
 }
 Value P_for_each(Value *a, int n) {
   map_generic(a, n, false, "for-each");
+  return Value::unspecified();
+}
+// parallel-map and parallel-for-each mean map and for-each; members may run
+// at the same time (in built executables, on threads and MPI ranks), so the
+// procedure may not assign variables it does not own. The interpreter runs
+// them in order: its output is what the executable's is.
+Value P_parallel_map(Value *a, int n) {
+  require_no_captured_assignment(a[0], "parallel-map");
+  return map_generic(a, n, true, "parallel-map");
+}
+Value P_parallel_for_each(Value *a, int n) {
+  require_no_captured_assignment(a[0], "parallel-for-each");
+  map_generic(a, n, false, "parallel-for-each");
   return Value::unspecified();
 }
 Value P_append_map(Value *a, int n) {
@@ -628,6 +642,8 @@ void install_list_primitives() {
   define_primitive("assoc", 2, 3, P_assoc);
   define_primitive("map", 2, kVariadic, P_map);
   define_primitive("for-each", 2, kVariadic, P_for_each);
+  define_primitive("parallel-map", 2, kVariadic, P_parallel_map);
+  define_primitive("parallel-for-each", 2, kVariadic, P_parallel_for_each);
   define_primitive("append-map", 2, kVariadic, P_append_map);
   define_primitive("filter", 2, 2, P_filter);
   define_primitive("remove", 2, 2, P_remove);

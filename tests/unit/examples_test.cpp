@@ -1,4 +1,4 @@
-// The figure scenes of examples/ (examples/figure-*.sicm), run small, both
+// The scenes of examples/ (examples/figure-*.sicm and sweep-*.sicm), run small, both
 // with `sicm run` and compiled by `sicm build`.
 //
 // Every scene begins with the line
@@ -52,14 +52,14 @@ std::string slurp(const fs::path &path) {
   return s.str();
 }
 
-// The scenes, sorted by name: examples/figure-*.sicm.
+// The scenes, sorted by name: examples/figure-*.sicm and sweep-*.sicm.
 std::vector<std::string> scene_names() {
   std::vector<std::string> names;
   std::error_code ec;
   for (const auto &entry : fs::directory_iterator("examples", ec)) {
     std::string file = entry.path().filename().string();
-    if (file.rfind("figure-", 0) == 0 && entry.path().extension() == ".sicm")
-      names.push_back(entry.path().stem().string());
+    bool scene = file.rfind("figure-", 0) == 0 || file.rfind("sweep-", 0) == 0;
+    if (scene && entry.path().extension() == ".sicm") names.push_back(entry.path().stem().string());
   }
   std::sort(names.begin(), names.end());
   return names;
