@@ -366,7 +366,7 @@ namespace {
 // A run-time scalar as a variable (an expression gets a Let).
 Value as_var(Value v) {
   if (var_of(v) >= 0) return v;
-  return let(RCompute::Expr, {expr_of(v, "printing")}, RType::Real);
+  return let(RCompute::Expr, {expr_of(v, "printing")}, scalar_type(v)); // a sum of counts is one
 }
 
 // Output text; names of run-time variables in it (printed from a value
