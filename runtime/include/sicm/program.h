@@ -197,8 +197,11 @@ void sicm_parallel_map(const sicm_site *site, const sicm_closure *fns, size_t nf
 void sicm_parallel_set_threads(int n);
 int sicm_parallel_threads(void);
 
-/* Programs built with --mpi call this first, before sicm_program_init:
- * MPI_Init (MPI_Init_thread, funneled: only the calling thread calls MPI),
+/* Programs built with --mpi call this first, before sicm_program_init.
+ * Started without an MPI launcher (no rank in the environment: mpirun,
+ * mpiexec, srun set one), it does nothing and the program runs as one
+ * process. Under one: MPI_Init (MPI_Init_thread, funneled: only the calling
+ * thread calls MPI),
  * MPI_Finalize at exit (a normal exit and a failure's exit 70 alike), and
  * every rank but 0 stays quiet: it prints nothing, writes no plot file and,
  * on a failure, exits with the same status without a message. Defined only
