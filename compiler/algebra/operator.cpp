@@ -299,6 +299,22 @@ bool is_operator(Value v) {
   return v.is(Tag::Opaque) && v.as<Opaque>()->kind == &kOperatorKind;
 }
 
+bool is_derivative_multiple(Value op, Value *c) {
+  if (!is_operator(op)) return false;
+  Operator *o = as_operator(op);
+  if (o->kind == OperatorKind::Derivative && o->npath == 0) {
+    *c = Value::fixnum(1);
+    return true;
+  }
+  Value inner;
+  if (o->kind == OperatorKind::Scale && !is_operator(o->a) &&
+      is_derivative_multiple(o->b, &inner)) {
+    *c = g_mul(o->a, inner);
+    return true;
+  }
+  return false;
+}
+
 Value derivative_of(Value f, const std::vector<int> &path) {
   gcvec<Value> items;
   for (int i : path)

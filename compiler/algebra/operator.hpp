@@ -13,6 +13,8 @@ namespace sicm {
 bool is_operator(Value v);
 // Apply an operator to a function, giving a function.
 Value apply_operator(Value op, Value f);
+// Is op c D, D times something that is not an operator (D itself: c = 1)?
+bool is_derivative_multiple(Value op, Value *c);
 // The derivative of f with respect to the argument component selected by
 // `path` (empty: with respect to every argument, as D does).
 Value derivative_of(Value f, const std::vector<int> &path);

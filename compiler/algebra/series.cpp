@@ -20,13 +20,18 @@ namespace sicm {
 namespace {
 
 enum class SeriesKind {
-  Exp,      // a: operator x, b: function f; powers: x^k f
-  Applied,  // a: series of functions, b: argument list
-  Sum,      // a + b
-  Scale,    // coefficient a times series b
-  Product,  // Cauchy product of a and b
-  Quotient, // a / b: the series c with c b = a, term by term (b's first term not zero)
-  Given,    // the terms listed, then zeros
+  Exp,        // a: operator x, b: function f; powers: x^k f
+  Applied,    // a: series of functions, b: argument list
+  Sum,        // a + b
+  Scale,      // coefficient a times series b
+  Product,    // Cauchy product of a and b
+  Quotient,   // a / b: the series c with c b = a, term by term (b's first term not zero)
+  Given,      // the terms listed, then zeros
+  Derivative, // d/dt of series a: term k is (k + 1) a_{k+1}
+  Integral,   // the series whose term 0 is a and whose derivative is series b
+  Power,      // series a to the power b (not a series): (a^b)' = b a' a^(b-1), the series
+              // a^(b-1) made when first needed (in powers[0]), and so on down, so that the
+              // terms are those of repeated differentiation and print as they do
 };
 
 struct Series {
@@ -93,6 +98,20 @@ Value compute_term(Series *s, size_t k) {
       rest = g_sub(rest, g_mul(series_term(s->b, i), s->terms[k - i]));
     return g_div(rest, b0);
   }
+  case SeriesKind::Derivative:
+    return g_mul(Value::fixnum(static_cast<int64_t>(k + 1)), series_term(s->a, k + 1));
+  case SeriesKind::Integral:
+    if (k == 0) return s->a;
+    return g_div(series_term(s->b, k - 1), Value::fixnum(static_cast<int64_t>(k)));
+  case SeriesKind::Power: {
+    if (k == 0) return g_binary(BinaryOp::Expt, series_term(s->a, 0), s->b);
+    if (s->powers.empty()) {
+      Value da = make_series(SeriesKind::Derivative, s->a, Value());
+      Value lower = make_series(SeriesKind::Power, s->a, g_sub(s->b, Value::fixnum(1)));
+      s->powers.push_back(g_mul(s->b, g_mul(da, lower)));
+    }
+    return g_div(series_term(s->powers[0], k - 1), Value::fixnum(static_cast<int64_t>(k)));
+  }
   case SeriesKind::Given: {
     long n = list_length(s->a);
     if (static_cast<long>(k) >= n) return Value::fixnum(0);
@@ -105,19 +124,111 @@ Value compute_term(Series *s, size_t k) {
   internal_failure(__FILE__, __LINE__, "unknown series kind");
 }
 
+Value constant_series(Value x) {
+  return make_series(SeriesKind::Given, list({x}), Value());
+}
+
+// ((exp (* c D)) f) at x is f(x + c t) as a power series in t: when f
+// computes with arithmetic and elementary functions, it can be given the
+// series x + c t itself, and every term then costs a few convolutions (the
+// recurrences below), where differentiating k times nests k differentials
+// (the 20th term of ((exp (* 1/2 D)) sin) took seconds). Anything else (a
+// literal function, an operation a series does not take, a value that is
+// not a series) is left to the series of derivatives: unspecified here.
+Value taylor_by_substitution(Series *s, Value x) {
+  Value c;
+  if (s->kind != SeriesKind::Exp || !is_derivative_multiple(s->a, &c)) return Value();
+  if (!is_number(x) && !x.is(Tag::Symbol) && !x.is(Tag::Expr)) return Value();
+  Value shifted = make_series(SeriesKind::Given, list({x, c}), Value());
+  try {
+    Value r = apply_procedure(s->b, &shifted, 1);
+    if (is_series(r)) return r;
+  } catch (const Error &) {
+  }
+  return Value();
+}
+
 Value series_apply(void *obj, Value *args, int nargs) {
+  if (nargs == 1) {
+    Value r = taylor_by_substitution(static_cast<Series *>(obj), args[0]);
+    if (is_series(r)) return r;
+  }
   Value self = Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kSeriesKind, obj}));
   return make_series(SeriesKind::Applied, self, list_from(args, static_cast<size_t>(nargs)));
 }
 
-Value constant_series(Value x) {
-  return make_series(SeriesKind::Given, list({x}), Value());
+// The series whose term 0 is c and whose derivative is derivative_of(it):
+// the derivative may refer to the series itself (e' = a' e), since its term
+// k - 1 needs only the series' terms before k.
+template <typename F> Value integral_series(Value c, F derivative_of) {
+  Value s = make_series(SeriesKind::Integral, c, Value());
+  Value d = derivative_of(s);
+  as_series(s)->b = d;
+  return s;
+}
+
+// Elementary functions of a series a, from its first term and its
+// derivative a' (each satisfies a first-order equation in a'); unspecified
+// for the others.
+Value series_function(UnaryOp op, Value a) {
+  Value a0 = series_term(a, 0);
+  Value da = make_series(SeriesKind::Derivative, a, Value());
+  Value one = Value::fixnum(1);
+  auto root_of_one_minus_square = [&] { return g_unary(UnaryOp::Sqrt, g_sub(one, g_mul(a, a))); };
+  switch (op) {
+  case UnaryOp::Exp: return integral_series(g_unary(op, a0), [&](Value e) { return g_mul(da, e); });
+  case UnaryOp::Log: return integral_series(g_unary(op, a0), [&](Value) { return g_div(da, a); });
+  case UnaryOp::Sqrt:
+    return integral_series(g_unary(op, a0),
+                           [&](Value r) { return g_div(da, g_mul(Value::fixnum(2), r)); });
+  case UnaryOp::Sin:
+  case UnaryOp::Cos: {
+    Value sin = make_series(SeriesKind::Integral, g_unary(UnaryOp::Sin, a0), Value());
+    Value cos = make_series(SeriesKind::Integral, g_unary(UnaryOp::Cos, a0), Value());
+    as_series(sin)->b = g_mul(da, cos);
+    as_series(cos)->b = g_neg(g_mul(da, sin));
+    return op == UnaryOp::Sin ? sin : cos;
+  }
+  case UnaryOp::Tan: { // tan' = 1 / cos^2, as D writes it
+    Value cos = series_function(UnaryOp::Cos, a);
+    return integral_series(g_unary(op, a0), [&](Value) { return g_div(da, g_mul(cos, cos)); });
+  }
+  case UnaryOp::Atan:
+    return integral_series(g_unary(op, a0),
+                           [&](Value) { return g_div(da, g_add(one, g_mul(a, a))); });
+  case UnaryOp::Asin:
+    return integral_series(g_unary(op, a0),
+                           [&](Value) { return g_div(da, root_of_one_minus_square()); });
+  case UnaryOp::Acos:
+    return integral_series(g_unary(op, a0),
+                           [&](Value) { return g_neg(g_div(da, root_of_one_minus_square())); });
+  case UnaryOp::Square: return g_mul(a, a);
+  case UnaryOp::Cube: return g_mul(a, g_mul(a, a));
+  default: return Value();
+  }
+}
+
+// a^p with a or p a series: products for a natural power, the Power series
+// for another power p, exp(p log a) for a series p.
+Value series_expt(Value a, Value p) {
+  if (is_series(a) && p.is(Tag::Fixnum) && p.i >= 0) {
+    Value result = constant_series(Value::fixnum(1)), base = a;
+    for (int64_t n = p.i; n > 0; n >>= 1) {
+      if (n & 1) result = g_mul(result, base);
+      if (n > 1) base = g_mul(base, base);
+    }
+    return result;
+  }
+  if (is_series(a) && !is_series(p)) return make_series(SeriesKind::Power, a, p);
+  return g_unary(UnaryOp::Exp, g_mul(p, g_unary(UnaryOp::Log, a)));
 }
 
 Value series_unary(UnaryOp op, Value x) {
   if (op == UnaryOp::Neg) return make_series(SeriesKind::Scale, Value::fixnum(-1), x);
   if (op == UnaryOp::Invert)
     return make_series(SeriesKind::Quotient, constant_series(Value::fixnum(1)), x);
+  Value f = series_function(op, x);
+  if (is_series(f)) return f;
   arith_wrong_type(op, x);
 }
 
@@ -135,6 +246,7 @@ Value series_binary(BinaryOp op, Value a, Value b) {
   case BinaryOp::Div:
     if (sa && !sb) return make_series(SeriesKind::Scale, g_unary(UnaryOp::Invert, b), a);
     return make_series(SeriesKind::Quotient, sa ? a : constant_series(a), b);
+  case BinaryOp::Expt: return series_expt(a, b);
   default: break;
   }
   arith_wrong_type(op, sa ? b : a, sa ? 2 : 1);
