@@ -1,11 +1,11 @@
-/* Minimization: Brent's method in one dimension and Nelder-Mead in several, over GSL. */
+/* Minimization in one dimension: Brent's method, over GSL (Nelder-Mead, in
+ * several, is nelder_mead.c). */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_min.h>
-#include <gsl/gsl_multimin.h>
 
 #include "sicm/runtime.h"
 #include "watched_fn.h"
@@ -113,89 +113,5 @@ int sicm_min_brent(double (*f)(double, void *), void *params, double a, double b
   if (xmin) *xmin = x;
   if (fmin) *fmin = fx;
   if (iterations) *iterations = iter;
-  return status;
-}
-
-/* The user's function of n variables, watched for non-finite values. */
-typedef struct {
-  double (*f)(const double *, void *);
-  void *params;
-  int bad;
-} fnn;
-
-static double calln(const gsl_vector *x, void *data) {
-  fnn *w = data;
-  double v = w->f(x->data, w->params); /* x->stride is 1 for GSL's own vectors */
-  if (!isfinite(v)) w->bad = 1;
-  return v;
-}
-
-int sicm_min_nelder_mead(double (*f)(const double *x, void *), void *params, size_t n, double *x,
-                         double step, double tol, int max_iter, double *fmin, int *iterations) {
-  static const char who[] = "sicm_min_nelder_mead";
-  if (n == 0 || !(step > 0) || !isfinite(step) || !(tol >= 0) || !isfinite(tol) || max_iter <= 0)
-    return sicm_error(SICM_EINVAL,
-                      "%s: need n >= 1, a positive step, tol >= 0 and max_iter > 0 (n = %zu, "
-                      "step = %g, tol = %g, max_iter = %d)",
-                      who, n, step, tol, max_iter);
-  for (size_t i = 0; i < n; i++)
-    if (!isfinite(x[i]))
-      return sicm_error(SICM_EINVAL, "%s: the starting point has a non-finite component x[%zu]",
-                        who, i);
-  gsl_error_handler_t *old = gsl_set_error_handler_off();
-  fnn w = {f, params, 0};
-  gsl_multimin_function F = {calln, n, &w};
-  gsl_vector *x0 = gsl_vector_alloc(n), *ss = gsl_vector_alloc(n);
-  gsl_multimin_fminimizer *s = gsl_multimin_fminimizer_alloc(gsl_multimin_fminimizer_nmsimplex2, n);
-  int status = SICM_SUCCESS, iter = 0;
-  if (!x0 || !ss || !s) {
-    status = sicm_error(SICM_ENOMEM, "%s: out of memory", who);
-    goto done;
-  }
-  for (size_t i = 0; i < n; i++)
-    gsl_vector_set(x0, i, x[i]);
-  gsl_vector_set_all(ss, step);
-  int gs = gsl_multimin_fminimizer_set(s, &F, x0, ss);
-  if (w.bad || gs != GSL_SUCCESS) {
-    status = w.bad ? sicm_error(SICM_EBADFUNC,
-                                "%s: the function is not finite on the starting simplex "
-                                "(start and step %g)",
-                                who, step)
-                   : sicm_error(SICM_EFAILED, "%s: GSL: %s", who, gsl_strerror(gs));
-    goto done;
-  }
-  for (;;) {
-    if (gsl_multimin_fminimizer_size(s) < tol) break;
-    if (iter >= max_iter) {
-      status = sicm_error(SICM_EMAXITER,
-                          "%s: simplex size %g still above tolerance %g after %d iterations; "
-                          "x holds the best point, f = %.17g",
-                          who, gsl_multimin_fminimizer_size(s), tol, max_iter,
-                          gsl_multimin_fminimizer_minimum(s));
-      break;
-    }
-    iter++;
-    gs = gsl_multimin_fminimizer_iterate(s);
-    if (gs != GSL_SUCCESS && !w.bad) {
-      status =
-          sicm_error(SICM_EFAILED, "%s: GSL: %s after %d iterations", who, gsl_strerror(gs), iter);
-      break;
-    }
-    /* A non-finite trial value just loses the comparison inside the simplex
-     * method; it is only an error if the best point itself is not finite. */
-    if (!isfinite(gsl_multimin_fminimizer_minimum(s))) {
-      status = sicm_error(SICM_EBADFUNC, "%s: the function is not finite at the best point", who);
-      break;
-    }
-  }
-  for (size_t i = 0; i < n; i++)
-    x[i] = gsl_vector_get(gsl_multimin_fminimizer_x(s), i);
-  if (fmin) *fmin = gsl_multimin_fminimizer_minimum(s);
-done:
-  if (iterations) *iterations = iter;
-  if (s) gsl_multimin_fminimizer_free(s);
-  if (x0) gsl_vector_free(x0);
-  if (ss) gsl_vector_free(ss);
-  gsl_set_error_handler(old);
   return status;
 }

@@ -37,13 +37,16 @@ int sicm_min_brent(double (*f)(double, void *), void *params, double a, double b
                    double *xmin, double *fmin, int *iterations);
 
 /* sicm_min_nelder_mead minimizes f over R^n (n >= 1) by the Nelder-Mead
- * downhill simplex method (GSL's gsl_multimin_fminimizer_nmsimplex2).
+ * downhill simplex method (runtime/src/nelder_mead.c).
  *
  * x[0..n-1] is the starting point on entry and the best point found on
  * return; step (> 0) is the size of the initial simplex along each axis.
  * The search stops when the simplex size (the mean distance of its vertices
- * from their centre) is below tol (>= 0), and fails with SICM_EMAXITER after
- * max_iter (> 0) iterations. The minimum's value is stored in *fmin and the
+ * from their centre) is below tol (>= 0), or, as scmutils' nelder-mead
+ * does, when the values at its vertices agree to tol relative to their size
+ * (f_worst - f_best <= tol (|f_best| + |f_worst|) / 2), and fails with
+ * SICM_EMAXITER after max_iter (> 0) iterations, or earlier when the
+ * simplex runs off to infinity (f has no minimum near the start). The minimum's value is stored in *fmin and the
  * number of iterations in *iterations (both may be NULL).
  *
  * Nelder-Mead needs no derivatives and tolerates noise, but it converges
