@@ -267,8 +267,18 @@ Value diff_expt(Value base, Value exponent) {
     Value slope = g_mul(exponent, g_expt(b0, n_minus_1));
     return g_add(g_expt(b0, exponent), times_infinitesimal(g_mul(slope, b1), e));
   }
-  // a^b = exp(b log a) when the exponent varies.
-  return g_unary(UnaryOp::Exp, g_mul(exponent, g_unary(UnaryOp::Log, base)));
+  // When the exponent varies: d(a^b) = a^b (db log a + b da / a), the value
+  // kept as (expt a b), as scmutils keeps it (not exp(b log a)); a term
+  // whose infinitesimal part is 0 is left out (log a of a negative base).
+  uint32_t e = std::max(max_differential_tag(base), max_differential_tag(exponent));
+  Value b0, b1, x0, x1;
+  split_differential(base, e, &b0, &b1);
+  split_differential(exponent, e, &x0, &x1);
+  Value value = g_expt(b0, x0);
+  Value rate = Value::fixnum(0);
+  if (!is_exact_zero(x1)) rate = g_mul(x1, g_unary(UnaryOp::Log, b0));
+  if (!is_exact_zero(b1)) rate = g_add(rate, g_div(g_mul(x0, b1), b0));
+  return g_add(value, times_infinitesimal(g_mul(value, rate), e));
 }
 
 Value diff_atan2(Value y, Value x) {
