@@ -20,18 +20,20 @@ namespace sicm {
 namespace {
 
 enum class SeriesKind {
-  Exp,        // a: operator x, b: function f; powers: x^k f
-  Applied,    // a: series of functions, b: argument list
-  Sum,        // a + b
-  Scale,      // coefficient a times series b
-  Product,    // Cauchy product of a and b
-  Quotient,   // a / b: the series c with c b = a, term by term (b's first term not zero)
-  Given,      // the terms listed, then zeros
-  Derivative, // d/dt of series a: term k is (k + 1) a_{k+1}
-  Integral,   // the series whose term 0 is a and whose derivative is series b
-  Power,      // series a to the power b (not a series): (a^b)' = b a' a^(b-1), the series
-              // a^(b-1) made when first needed (in powers[0]), and so on down, so that the
-              // terms are those of repeated differentiation and print as they do
+  Exp,         // a: operator x, b: function f; powers: x^k f
+  ExpOfSeries, // a: operator x, b: series h (of functions); powers: the Exp series of x and
+               // h_j; term n is the sum over k + j = n of x^k h_j / k!
+  Applied,     // a: series of functions, b: argument list
+  Sum,         // a + b
+  Scale,       // coefficient a times series b
+  Product,     // Cauchy product of a and b
+  Quotient,    // a / b: the series c with c b = a, term by term (b's first term not zero)
+  Given,       // the terms listed, then zeros
+  Derivative,  // d/dt of series a: term k is (k + 1) a_{k+1}
+  Integral,    // the series whose term 0 is a and whose derivative is series b
+  Power,       // series a to the power b (not a series): (a^b)' = b a' a^(b-1), the series
+               // a^(b-1) made when first needed (in powers[0]), and so on down, so that the
+               // terms are those of repeated differentiation and print as they do
 };
 
 struct Series {
@@ -72,6 +74,20 @@ Value compute_term(Series *s, size_t k) {
     while (s->powers.size() <= k)
       s->powers.push_back(s->powers.empty() ? s->b : apply_operator(s->a, s->powers.back()));
     return g_mul(num_div(Value::fixnum(1), factorial(k)), s->powers[k]);
+  }
+  case SeriesKind::ExpOfSeries: {
+    // exp(x) h = sum_k x^k/k! sum_j h_j, collected by total order: the order
+    // of a term of h (a power of epsilon in the book's H-pendulum-series)
+    // plus that of the operator's power (epsilon L_W), as scmutils collects it.
+    // A zero term of h (the series' padding) contributes nothing at any order.
+    while (s->powers.size() <= k) {
+      Value h = series_term(s->b, s->powers.size());
+      s->powers.push_back(is_exact_zero(h) ? h : make_series(SeriesKind::Exp, s->a, h));
+    }
+    Value sum = Value::fixnum(0);
+    for (size_t j = 0; j <= k; ++j)
+      if (!is_exact_zero(s->powers[j])) sum = g_add(sum, series_term(s->powers[j], k - j));
+    return sum;
   }
   case SeriesKind::Applied: {
     gcvec<Value> args = list_to_vector(s->b);
@@ -321,7 +337,7 @@ Value series_term(Value v, size_t k) {
 }
 
 Value make_exp_series(Value op, Value f) {
-  return make_series(SeriesKind::Exp, op, f);
+  return make_series(is_series(f) ? SeriesKind::ExpOfSeries : SeriesKind::Exp, op, f);
 }
 
 void install_series_primitives() {
