@@ -63,11 +63,13 @@ const char kUsage[] =
     "                            prints what each integration cost on stderr (so\n"
     "                            do built programs given --stats)\n"
     "       sicm build FILE [-o EXE] [-O0|-O1|-O2|-O3] [--keep-c] [--report[=PATH]]\n"
-    "                  [--fix NAME=VALUE ...] [--mpi]\n"
+    "                  [--fix NAME=VALUE ...] [--mpi] [--dump=PASS]\n"
     "                            compile to an executable (default: FILE without\n"
     "                            .sicm); --keep-c leaves the C as EXE.c; --mpi links\n"
     "                            Open MPI: under mpirun, parallel-map's members are\n"
-    "                            spread over the ranks\n"
+    "                            spread over the ranks; --dump=PASS prints one\n"
+    "                            intermediate form instead (analyzed, residual,\n"
+    "                            kernels, c; also for emit-c)\n"
     "                            --report[=PATH] also writes what each kernel\n"
     "                            computes, as JSON (default PATH: EXE.report.json);\n"
     "                            --fix makes (parameter 'NAME ...) the constant VALUE\n"
@@ -286,6 +288,16 @@ int dispatch(const std::vector<std::string> &args) {
         o.keep_c = true;
       } else if (a == "--mpi" && cmd == "build") {
         o.mpi = true;
+      } else if (a.rfind("--dump=", 0) == 0 && (cmd == "build" || cmd == "emit-c")) {
+        o.dump = a.substr(7);
+        bool known = false;
+        for (const char *pass : sicm::kDumpPasses)
+          known = known || o.dump == pass;
+        if (!known) {
+          std::fprintf(stderr, "sicm: --dump=%s: not one of analyzed, residual, kernels, c\n",
+                       o.dump.c_str());
+          return kExitUsage;
+        }
       } else if (o.input.empty() && a.rfind("-", 0) != 0) {
         o.input = a;
       } else {

@@ -16,12 +16,16 @@
 
 #include "codegen/jit.hpp"
 #include "codegen/kernel_report.hpp"
+#include "codegen/residual_dump.hpp"
 #include "codegen/residual_emit.hpp"
+#include "eval/analyze.hpp"
+#include "eval/analyzed_dump.hpp"
 #include "eval/build.hpp"
 #include "eval/core.hpp"
 #include "eval/effects_used.hpp"
 #include "eval/interp.hpp"
 #include "syntax/error.hpp"
+#include "syntax/reader.hpp"
 
 extern char **environ;
 
@@ -108,11 +112,28 @@ int build_program(const BuildOptions &o) {
   text << in.rdbuf();
   uint32_t file = register_source(o.input, text.str());
 
+  if (o.dump == "analyzed") {
+    for (const ReadForm &f : read_all(file))
+      std::printf("%s\n", dump_node(analyze_form(f.datum, f.loc, nullptr)).c_str());
+    return 0;
+  }
   ResidualProgram program;
   program.source_name = base_name(o.input);
   begin_build_mode(&program);
   run_source(file);
+  if (o.dump == "residual") {
+    std::fputs(dump_residual(program).c_str(), stdout);
+    return 0;
+  }
   std::string c = emit_residual_program(program);
+  if (o.dump == "kernels") {
+    std::fputs(report_table(report_kernels(program, c), used_effects()).c_str(), stdout);
+    return 0;
+  }
+  if (o.dump == "c") {
+    std::fwrite(c.data(), 1, c.size(), stdout);
+    return 0;
+  }
 
   if (!o.report_path.empty()) {
     std::vector<KernelReport> kernels = report_kernels(program, c);
