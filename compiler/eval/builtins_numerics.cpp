@@ -1041,19 +1041,10 @@ Value P_find_root(Value *a, int n) {
   return Value::flonum(root);
 }
 
-// scmutils' close-enuf?: |x - y| <= tol/2 (|x| + |y| + 2), tol at least the
-// machine epsilon.
-bool close_enough(double x, double y, double tol) {
-  return std::fabs(x - y) <= 0.5 * std::fmax(tol, DBL_EPSILON) * (std::fabs(x) + std::fabs(y) + 2);
-}
-
-int sign_of(double v) {
-  return v > 0 ? 1 : v < 0 ? -1 : 0;
-}
-
 // (bisect f x0 x1 eps [n-break]): a root of f between x0 and x1 by
 // bisection (then, after n-break halvings, by false position), until the
 // ends are close-enuf? to eps; f's values need only have the right signs.
+// The runtime's sicm_root_bisect takes the steps, as in built programs.
 Value P_bisect(Value *a, int n) {
   static const char who[] = "bisect";
   SrcLoc loc = current_call_loc();
@@ -1063,35 +1054,21 @@ Value P_bisect(Value *a, int n) {
   if (!(eps >= 0)) bad_range(a[3], 4, who);
   long n_break = is_missing(a, n, 4) ? kBisectBreak : static_cast<long>(arg_index(a, 4, who));
   ScalarCallback cb(loc, who, f);
-  auto value = [&](double x) {
-    Value arg = Value::flonum(x);
-    return real_result(cb, apply_procedure(f, &arg, 1), number_text(x));
-  };
-  double f0 = real_result(cb, apply_procedure(f, &a[1], 1), write_string(a[1]));
-  double f1 = real_result(cb, apply_procedure(f, &a[2], 1), write_string(a[2]));
-  for (long iter = 0;; ++iter) {
-    if (f0 == 0) return Value::flonum(x0);
-    if (f1 == 0) return Value::flonum(x1);
-    if (sign_of(f0) * sign_of(f1) > 0 || std::isnan(f0) || std::isnan(f1))
-      numeric_error(loc, who,
-                    "root not bounded: the function is " + number_text(f0) + " at " +
-                        number_text(x0) + " and " + number_text(f1) + " at " + number_text(x1));
-    double xm = iter < n_break ? (x0 + x1) / 2 : (f1 * x0 - f0 * x1) / (f1 - f0);
-    if (close_enough(x0, x1, eps)) return Value::flonum(xm);
-    if (iter >= kBisectMaxIter)
-      numeric_error(loc, who,
-                    "no convergence in " + std::to_string(kBisectMaxIter) +
-                        " iterations; the root is between " + number_text(x0) + " and " +
-                        number_text(x1));
-    double fm = value(xm);
-    if (sign_of(f1) * sign_of(fm) < 0) {
-      x0 = xm;
-      f0 = fm;
-    } else {
-      x1 = xm;
-      f1 = fm;
-    }
-  }
+  double root = 0, bracket[2], values[2];
+  int status = sicm_root_bisect(call_scalar, &cb, x0, x1, eps, n_break, kBisectMaxIter, &root,
+                                bracket, values);
+  cb.rethrow_if_failed();
+  if (status == SICM_EBRACKET)
+    numeric_error(loc, who,
+                  "root not bounded: the function is " + number_text(values[0]) + " at " +
+                      number_text(bracket[0]) + " and " + number_text(values[1]) + " at " +
+                      number_text(bracket[1]));
+  if (status != SICM_SUCCESS)
+    numeric_error(loc, who,
+                  "no convergence in " + std::to_string(kBisectMaxIter) +
+                      " iterations; the root is between " + number_text(bracket[0]) + " and " +
+                      number_text(bracket[1]));
+  return Value::flonum(root);
 }
 
 // ---- eigenvalues ----------------------------------------------------------------

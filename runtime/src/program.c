@@ -426,54 +426,29 @@ double sicm_drive_find_root(const sicm_site *site, sicm_closure f, double a, dou
   return root;
 }
 
-/* scmutils' close-enuf?: |x - y| <= tol/2 (|x| + |y| + 2), tol at least the
- * machine epsilon. */
-static int close_enough(double x, double y, double tol) {
-  return fabs(x - y) <= 0.5 * fmax(tol, DBL_EPSILON) * (fabs(x) + fabs(y) + 2);
-}
-
-static int sign_of(double v) {
-  return v > 0 ? 1 : v < 0 ? -1 : 0;
-}
-
 double sicm_drive_bisect(const sicm_site *site, sicm_closure f, double x0, double x1, double eps,
                          long n_break) {
   static const char who[] = "bisect";
   enum { kMaxIterations = 10000 };
-  double f0 = scalar_of(x0, &f), f1 = scalar_of(x1, &f);
+  double root = 0, bracket[2], values[2];
+  int status =
+      sicm_root_bisect(scalar_of, &f, x0, x1, eps, n_break, kMaxIterations, &root, bracket, values);
+  if (status == SICM_SUCCESS) return root;
   char reason[256], a[SICM_DOUBLE_BUFSIZE], b[SICM_DOUBLE_BUFSIZE];
-  for (long iter = 0;; ++iter) {
-    if (f0 == 0) return x0;
-    if (f1 == 0) return x1;
-    if (sign_of(f0) * sign_of(f1) > 0 || isnan(f0) || isnan(f1)) {
-      char fa[SICM_DOUBLE_BUFSIZE], fb[SICM_DOUBLE_BUFSIZE];
-      sicm_format_double(fa, f0);
-      sicm_format_double(fb, f1);
-      sicm_format_double(a, x0);
-      sicm_format_double(b, x1);
-      snprintf(reason, sizeof reason, "root not bounded: the function is %s at %s and %s at %s", fa,
-               a, fb, b);
-      sicm_program_fail(site, who, reason);
-    }
-    double xm = iter < n_break ? (x0 + x1) / 2 : (f1 * x0 - f0 * x1) / (f1 - f0);
-    if (close_enough(x0, x1, eps)) return xm;
-    if (iter >= kMaxIterations) {
-      sicm_format_double(a, x0);
-      sicm_format_double(b, x1);
-      snprintf(reason, sizeof reason,
-               "no convergence in %d iterations; the root is between %s and %s",
-               (int)kMaxIterations, a, b);
-      sicm_program_fail(site, who, reason);
-    }
-    double fm = scalar_of(xm, &f);
-    if (sign_of(f1) * sign_of(fm) < 0) {
-      x0 = xm;
-      f0 = fm;
-    } else {
-      x1 = xm;
-      f1 = fm;
-    }
+  sicm_format_double(a, bracket[0]);
+  sicm_format_double(b, bracket[1]);
+  if (status == SICM_EBRACKET) {
+    char fa[SICM_DOUBLE_BUFSIZE], fb[SICM_DOUBLE_BUFSIZE];
+    sicm_format_double(fa, values[0]);
+    sicm_format_double(fb, values[1]);
+    snprintf(reason, sizeof reason, "root not bounded: the function is %s at %s and %s at %s", fa,
+             a, fb, b);
+  } else {
+    snprintf(reason, sizeof reason,
+             "no convergence in %d iterations; the root is between %s and %s", (int)kMaxIterations,
+             a, b);
   }
+  sicm_program_fail(site, who, reason);
 }
 
 /* ---- ordinary differential equations ------------------------------------------------- */

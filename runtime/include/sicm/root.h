@@ -1,4 +1,4 @@
-/* sicm runtime: roots of functions of one variable (Brent). */
+/* sicm runtime: roots of functions of one variable (Brent; scmutils' bisect). */
 #ifndef SICM_ROOT_H
 #define SICM_ROOT_H
 
@@ -21,6 +21,22 @@ extern "C" {
  * then holds the best estimate). */
 int sicm_root_brent(double (*f)(double, void *), void *params, double a, double b, double tol,
                     double *root);
+
+/* sicm_root_bisect is scmutils' bisect: a root of f between x0 and x1,
+ * halving the bracket for its first n_break steps and then stepping by false
+ * position, until the bracket's ends are close (|x0 - x1| <= eps/2 (|x0| +
+ * |x1| + 2), eps at least DBL_EPSILON; *root is then the next point), or f is
+ * exactly zero at an end (*root is that end). The last bracket and f's
+ * values there are stored in bracket[] and values[], for the caller's
+ * messages.
+ *
+ * Returns SICM_SUCCESS; SICM_EBRACKET if f has the same sign, or is NaN, at
+ * the ends of a bracket; SICM_EMAXITER after max_iter steps. Reports nothing
+ * through sicm_error: its callers (the bisect primitive, sicm_drive_bisect)
+ * word the failure in Scheme's terms. */
+int sicm_root_bisect(double (*f)(double, void *), void *params, double x0, double x1, double eps,
+                     long n_break, long max_iter, double *root, double bracket[2],
+                     double values[2]);
 
 #ifdef __cplusplus
 }
