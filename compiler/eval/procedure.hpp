@@ -33,7 +33,6 @@ struct Lambda;
 
 struct Node {
   NodeKind kind;
-  bool tail = false;  // in tail position of its lambda
   uint16_t depth = 0; // LocalRef / SetLocal: frames to walk up
   uint32_t index = 0; // LocalRef / SetLocal: slot; Let/Letrec: frame size
   SrcLoc loc;
