@@ -93,20 +93,6 @@ bool is_state_shape(Value v) {
   return true;
 }
 
-// The result leaves of a traced procedure as outputs, unsimplified: they
-// keep the order of operations the interpreter follows (so a built program
-// computes what `sicm run` computes), and expanding, say, (x - 2)^2 into
-// x^2 - 4x + 4 would lose the accuracy a minimizer near 2 needs.
-void set_outputs(Value result, const char *who) {
-  gcvec<Value> leaves;
-  if (!is_state_shape(result))
-    cannot_compile(here(), std::string("the procedure passed to ") + who + " returns " +
-                               describe(result) + ", not a number or a structure of numbers");
-  state_leaves(result, leaves);
-  for (Value leaf : leaves)
-    current().outputs.push_back(expr_of(leaf, who));
-}
-
 std::string procedure_name(Value proc) {
   if (proc.is(Tag::Closure) && proc.as<Closure>()->lambda->name)
     return proc.as<Closure>()->lambda->name->name;
@@ -120,6 +106,20 @@ int in_new_function(const std::string &name, const std::function<void()> &body) 
 }
 
 namespace {
+
+// The result leaves of a traced procedure as outputs, unsimplified: they
+// keep the order of operations the interpreter follows (so a built program
+// computes what `sicm run` computes), and expanding, say, (x - 2)^2 into
+// x^2 - 4x + 4 would lose the accuracy a minimizer near 2 needs.
+void set_outputs(Value result, const char *who) {
+  gcvec<Value> leaves;
+  if (!is_state_shape(result))
+    cannot_compile(here(), std::string("the procedure passed to ") + who + " returns " +
+                               describe(result) + ", not a number or a structure of numbers");
+  state_leaves(result, leaves);
+  for (Value leaf : leaves)
+    current().outputs.push_back(expr_of(leaf, who));
+}
 
 // Trace a scalar function (integrand, objective, function with a root).
 int trace_scalar(Value f, const char *who) {

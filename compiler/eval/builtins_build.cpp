@@ -462,6 +462,15 @@ bool any_dynamic(Value *a, int n) {
   return false;
 }
 
+// x and y, either possibly a run-time truth value.
+Value both(Value x, Value y, const char *who) {
+  if (!is_dynamic_boolean(x) && !is_dynamic_boolean(y))
+    return Value::boolean(x.truthy() && y.truthy());
+  if (!is_dynamic_boolean(x)) return x.truthy() ? y : x;
+  if (!is_dynamic_boolean(y)) return y.truthy() ? x : y;
+  return let(RCompute::Select, {expr_of(x, who), expr_of(y, who), expr_integer(0)}, RType::Boolean);
+}
+
 // a0 op a1 op a2 ...: the conjunction of the pairwise comparisons.
 Value compare_chain(Value *a, int n, RCompute c, bool swap, const char *who) {
   Value result = Value::boolean(true);
@@ -474,14 +483,7 @@ Value compare_chain(Value *a, int n, RCompute c, bool swap, const char *who) {
     } else {
       r = let(c, {expr_of(x, who), expr_of(y, who)}, RType::Boolean);
     }
-    if (i == 0) {
-      result = r;
-    } else if (is_dynamic_boolean(result) || is_dynamic_boolean(r)) {
-      result = let(RCompute::Select, {expr_of(result, who), expr_of(r, who), expr_integer(0)},
-                   RType::Boolean);
-    } else {
-      result = Value::boolean(result.truthy() && r.truthy());
-    }
+    result = i == 0 ? r : both(result, r, who);
   }
   return result;
 }
@@ -495,15 +497,6 @@ constexpr char kGreater[] = ">";
 constexpr char kLessEq[] = "<=";
 constexpr char kGreaterEq[] = ">=";
 constexpr char kEqual[] = "=";
-
-// x and y, either possibly a run-time truth value.
-Value both(Value x, Value y, const char *who) {
-  if (!is_dynamic_boolean(x) && !is_dynamic_boolean(y))
-    return Value::boolean(x.truthy() && y.truthy());
-  if (!is_dynamic_boolean(x)) return x.truthy() ? y : x;
-  if (!is_dynamic_boolean(y)) return y.truthy() ? x : y;
-  return let(RCompute::Select, {expr_of(x, who), expr_of(y, who), expr_integer(0)}, RType::Boolean);
-}
 
 // A scalar's kind as eqv? sees it: a truth value, an exact number, an
 // inexact one.
