@@ -7,6 +7,7 @@
 
 #include "eval/limits.hpp"
 #include "eval/number.hpp"
+#include "eval/primitive.hpp"
 
 namespace sicm {
 namespace {
@@ -235,6 +236,11 @@ ExprId expr_call(ExprId head, const ExprId *args, size_t nargs) {
 
 ExprId expr_from_number(Value v) {
   if (v.is(Tag::Flonum)) return expr_flonum(v.d);
+  if (v.is(Tag::Recnum))
+    runtime_error(current_call_loc(),
+                  "the complex number " + number_to_string(v) +
+                      " cannot enter a symbolic expression: sicm's symbolic algebra is over the "
+                      "real numbers");
   if (v.is(Tag::Fixnum)) return expr_integer(v.i);
   SICM_ASSERT(is_exact_rational(v));
   mpq_t q;

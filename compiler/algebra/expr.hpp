@@ -121,7 +121,8 @@ ExprId expr_symbol(Symbol *s);
 ExprId expr_apply(Op op, const ExprId *args, size_t nargs);
 ExprId expr_apply(Op op, std::initializer_list<ExprId> args);
 ExprId expr_call(ExprId head, const ExprId *args, size_t nargs);
-// A number Value (fixnum, bignum, ratnum, flonum) as a node.
+// A real number Value (fixnum, bignum, ratnum, flonum) as a node; a complex
+// one is a located error (expressions are over the reals).
 ExprId expr_from_number(Value v);
 
 // ---- access ----

@@ -129,8 +129,8 @@ Value number_unary(UnaryOp op, Value x) {
   case UnaryOp::Asin: return num_asin(x);
   case UnaryOp::Acos: return num_acos(x);
   case UnaryOp::Atan: return num_atan(x);
-  case UnaryOp::Abs:
-  case UnaryOp::Magnitude: return num_abs(x);
+  case UnaryOp::Abs: return num_abs(x); // of a real number only, as MIT
+  case UnaryOp::Magnitude: return num_magnitude(x);
   case UnaryOp::Square: return num_mul(x, x);
   case UnaryOp::Cube: return num_mul(x, num_mul(x, x));
   case UnaryOp::ZeroP: return Value::boolean(num_is_zero(x));

@@ -147,6 +147,7 @@ bool fold_numbers(Op op, const std::vector<ExprId> &args, ExprId *out) {
     return false;
   }
   if (!inexact && !is_exact(r)) return false;
+  if (is_recnum(r)) return false; // (asin 2): expressions are over the reals
   *out = expr_from_number(r);
   return true;
 }

@@ -1,8 +1,8 @@
 // Core primitives: registration, argument errors, equivalence, predicates,
 // control (apply, values, promises, errors, continuations) and output.
 #include <chrono>
-#include <ctime>
 #include <cstdio>
+#include <ctime>
 
 #include "algebra/structure.hpp"
 #include "eval/analyze.hpp"
@@ -84,6 +84,8 @@ bool eqv(Value a, Value b) {
   switch (a.tag) {
   case Tag::Bignum:
   case Tag::Ratnum: return num_equal(a, b);
+  case Tag::Recnum: // the parts are eqv?: 1+2i is not eqv? to 1.+2.i
+    return eqv(num_real_part(a), num_real_part(b)) && eqv(num_imag_part(a), num_imag_part(b));
   case Tag::String: return a.p == b.p;
   default: return false;
   }

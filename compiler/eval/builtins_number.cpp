@@ -155,13 +155,16 @@ Value prim_integer_p(Value *a, int) {
 Value prim_rational_p(Value *a, int) {
   return boolean(is_exact_rational(a[0]) || (is_flonum(a[0]) && std::isfinite(a[0].d)));
 }
+Value prim_real_p(Value *a, int) {
+  return boolean(is_real(a[0]));
+}
 Value prim_exact_p(Value *a, int) {
-  check_number(a[0], 1, "exact?");
+  if (!is_number(a[0])) wrong_type(a[0], 1, "exact?");
   return boolean(is_exact(a[0]));
 }
 Value prim_inexact_p(Value *a, int) {
-  check_number(a[0], 1, "inexact?");
-  return boolean(is_flonum(a[0]));
+  if (!is_number(a[0])) wrong_type(a[0], 1, "inexact?");
+  return boolean(!is_exact(a[0]));
 }
 Value prim_exact_rational_p(Value *a, int) {
   return boolean(is_exact_rational(a[0]));
@@ -236,7 +239,7 @@ int radix_arg(Value *args, int n, int i, const char *who) {
 }
 
 Value prim_number_to_string(Value *a, int n) {
-  check_number(a[0], 1, "number->string");
+  if (!is_number(a[0])) wrong_type(a[0], 1, "number->string");
   return make_string(number_to_string(a[0], radix_arg(a, n, 1, "number->string")));
 }
 
@@ -324,7 +327,7 @@ const PrimitiveSpec kArithmetic[] = {
     {"integer-round", 2, 2, prim_integer_round},
     {"integer-truncate", 2, 2, prim_integer_truncate},
     {"abs", 1, 1, unary<num_abs>},
-    {"magnitude", 1, 1, unary<num_abs>},
+    {"magnitude", 1, 1, unary<num_magnitude>},
     {"1+", 1, 1, prim_one_plus},
     {"-1+", 1, 1, prim_minus_one_plus},
     {"1-", 1, 1, prim_minus_one_plus},
@@ -352,7 +355,7 @@ const PrimitiveSpec kRounding[] = {
 const PrimitiveSpec kPredicates[] = {
     {"number?", 1, 1, prim_number_p},
     {"complex?", 1, 1, prim_number_p},
-    {"real?", 1, 1, prim_number_p},
+    {"real?", 1, 1, prim_real_p},
     {"rational?", 1, 1, prim_rational_p},
     {"integer?", 1, 1, prim_integer_p},
     {"exact?", 1, 1, prim_exact_p},
@@ -380,6 +383,12 @@ const PrimitiveSpec kFunctions[] = {
     {"asin", 1, 1, unary<num_asin>},
     {"acos", 1, 1, unary<num_acos>},
     {"atan", 1, 2, prim_atan},
+    {"make-rectangular", 2, 2, binary<make_rectangular>},
+    {"make-polar", 2, 2, binary<make_polar>},
+    {"real-part", 1, 1, unary<num_real_part>},
+    {"imag-part", 1, 1, unary<num_imag_part>},
+    {"angle", 1, 1, unary<num_angle>},
+    {"conjugate", 1, 1, unary<num_conjugate>},
     {"number->string", 1, 2, prim_number_to_string},
     {"string->number", 1, 2, prim_string_to_number},
     {"random", 1, 2, prim_random},

@@ -1074,9 +1074,9 @@ Value P_bisect(Value *a, int n) {
 // ---- eigenvalues ----------------------------------------------------------------
 
 // (eigenvalues M): the eigenvalues of the square matrix M of real numbers, by
-// the runtime (Eigen), as a list ordered by decreasing modulus. sicm has no
-// non-real numbers, so a complex eigenvalue re + i im is the pair (re . im);
-// a real one is a flonum. Conjugate pairs come with im > 0 first.
+// the runtime (Eigen), as a list ordered by decreasing modulus: a real one a
+// flonum, a complex one a complex number. Conjugate pairs come with im > 0
+// first.
 Value P_eigenvalues(Value *a, int) {
   static const char who[] = "eigenvalues";
   SrcLoc loc = current_call_loc();
@@ -1088,7 +1088,7 @@ Value P_eigenvalues(Value *a, int) {
   for (size_t i = 0; i < n; ++i)
     for (size_t j = 0; j < n; ++j) {
       Value x = matrix_at(m, i, j);
-      if (!is_number(x))
+      if (!is_real(x))
         numeric_error(loc, who,
                       "the entry (" + std::to_string(i) + ", " + std::to_string(j) + ") is " +
                           write_string(x) + ", not a real number");
@@ -1099,7 +1099,8 @@ Value P_eigenvalues(Value *a, int) {
     numeric_error(loc, who, reason_of(g_runtime_message));
   Value result = Value::nil();
   for (size_t k = n; k-- > 0;) {
-    Value z = im[k] == 0 ? Value::flonum(re[k]) : cons(Value::flonum(re[k]), Value::flonum(im[k]));
+    Value z = im[k] == 0 ? Value::flonum(re[k])
+                         : make_rectangular(Value::flonum(re[k]), Value::flonum(im[k]));
     result = cons(z, result);
   }
   return result;

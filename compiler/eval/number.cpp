@@ -1,4 +1,6 @@
-// The numeric tower (fixnums, GMP bignums and ratnums, flonums) with MIT Scheme's arithmetic.
+// The numeric tower (fixnums, GMP bignums and ratnums, flonums) with MIT
+// Scheme's arithmetic; recnums (complex numbers) are in complex.cpp, and the
+// operations here hand them over.
 #include "eval/number.hpp"
 
 #include <algorithm>
@@ -19,6 +21,10 @@ namespace sicm {
 
 static_assert(sizeof(long) == sizeof(int64_t), "GMP's _si functions must take an int64");
 
+[[noreturn]] void divide_by_zero(const char *who) {
+  runtime_error(current_call_loc(), std::string("Division by zero signalled by ") + who + ".");
+}
+
 namespace {
 
 // ---- GMP temporaries --------------------------------------------------------
@@ -36,15 +42,6 @@ struct Q {
 };
 
 // ---- errors -----------------------------------------------------------------
-
-[[noreturn]] void divide_by_zero(const char *who) {
-  runtime_error(current_call_loc(), std::string("Division by zero signalled by ") + who + ".");
-}
-
-[[noreturn]] void complex_result(const char *who) {
-  runtime_error(current_call_loc(),
-                std::string(who) + ": the result would be complex, which sicm does not support");
-}
 
 // ---- representation -----------------------------------------------------------
 
@@ -208,6 +205,10 @@ const char *op_name(Op op) {
 
 // MIT: an exact zero times a finite flonum is an exact zero.
 Value arith(Op op, Value a, Value b) {
+  if ((is_recnum(a) || is_recnum(b)) && is_number(a) && is_number(b))
+    return op == Op::Add   ? complex_add(a, b)
+           : op == Op::Sub ? complex_sub(a, b)
+                           : complex_mul(a, b);
   check_number(a, 1, op_name(op));
   check_number(b, 2, op_name(op));
   if (!is_flonum(a) && !is_flonum(b)) return exact_op(op, a, b);
@@ -264,10 +265,11 @@ int compare_numbers(Value a, Value b) {
 // ---- classification -------------------------------------------------------------
 
 bool is_number(Value v) {
-  return v.tag == Tag::Fixnum || v.tag == Tag::Flonum || v.tag == Tag::Bignum ||
-         v.tag == Tag::Ratnum;
+  return is_real(v) || v.tag == Tag::Recnum;
 }
 bool is_exact(Value v) {
+  if (v.tag == Tag::Recnum)
+    return is_exact_rational(v.as<Recnum>()->re) && is_exact_rational(v.as<Recnum>()->im);
   return is_exact_rational(v);
 }
 bool is_exact_integer(Value v) {
@@ -280,7 +282,8 @@ bool is_integer(Value v) {
   return is_exact_integer(v) || (is_flonum(v) && std::isfinite(v.d) && v.d == std::floor(v.d));
 }
 bool is_real(Value v) {
-  return is_number(v);
+  return v.tag == Tag::Fixnum || v.tag == Tag::Flonum || v.tag == Tag::Bignum ||
+         v.tag == Tag::Ratnum;
 }
 
 // ---- construction -----------------------------------------------------------------
@@ -345,6 +348,10 @@ Value num_mul(Value a, Value b) {
 // MIT: an exact zero divided by a flonum other than NaN is an exact zero, and
 // division by any zero, exact or not, is an error.
 Value num_div(Value a, Value b) {
+  if ((is_recnum(a) || is_recnum(b)) && is_number(a) && is_number(b)) {
+    if (num_is_zero(b)) divide_by_zero("/");
+    return complex_div(a, b);
+  }
   check_number(a, 1, "/");
   check_number(b, 2, "/");
   if (is_exact_zero(a) && is_flonum(b) && !std::isnan(b.d)) return a;
@@ -358,6 +365,7 @@ Value num_div(Value a, Value b) {
 }
 
 Value num_neg(Value a) {
+  if (is_recnum(a)) return complex_sub(Value::fixnum(0), a);
   check_number(a, 1, "integer-negate");
   if (is_flonum(a)) return Value::flonum(-a.d);
   return exact_op(Op::Sub, Value::fixnum(0), a);
@@ -370,12 +378,14 @@ int num_compare(Value a, Value b) {
 }
 
 bool num_equal(Value a, Value b) {
+  if ((is_recnum(a) || is_recnum(b)) && is_number(a) && is_number(b)) return complex_equal(a, b);
   check_number(a, 1, "integer-equal?");
   check_number(b, 2, "integer-equal?");
   return compare_numbers(a, b) == 0;
 }
 
 bool num_is_zero(Value a) {
+  if (is_recnum(a)) return complex_is_zero(a);
   check_number(a, 1, "zero?");
   return is_flonum(a) ? a.d == 0 : is_exact_zero(a);
 }
@@ -562,11 +572,13 @@ Value num_denominator(Value a) {
 }
 
 Value num_exact_to_inexact(Value a) {
+  if (is_recnum(a)) return complex_exact_to_inexact(a);
   check_number(a, 1, "exact->inexact");
   return is_flonum(a) ? a : Value::flonum(to_double(a));
 }
 
 Value num_inexact_to_exact(Value a) {
+  if (is_recnum(a)) return complex_inexact_to_exact(a);
   check_number(a, 1, "inexact->exact");
   if (!is_flonum(a)) return a;
   if (!std::isfinite(a.d)) wrong_type(a, 1, "inexact->exact");
@@ -602,7 +614,7 @@ double flonum_expt_general(double x, double y) {
     if (y > 0) return x;
     divide_by_zero("expt");
   }
-  if (x < 0 && y != std::floor(y)) complex_result("expt");
+  SICM_ASSERT(!(x < 0 && y != std::floor(y))); // num_expt went complex
   return std::pow(x, y);
 }
 
@@ -645,8 +657,8 @@ Value exact_integer_expt(Value b, Value e) {
   // result of more than kMaxPowerBits bits (32 MiB) is a mistake, not a
   // computation: refuse it as MIT refuses what it cannot allocate.
   constexpr double kMaxPowerBits = 268435456.0;
-  double bits = static_cast<double>(std::max(mpz_sizeinbase(mpq_numref(base.v), 2),
-                                             mpz_sizeinbase(mpq_denref(base.v), 2)));
+  double bits = static_cast<double>(
+      std::max(mpz_sizeinbase(mpq_numref(base.v), 2), mpz_sizeinbase(mpq_denref(base.v), 2)));
   if (bits > 1 && (bits - 1) * static_cast<double>(n) > kMaxPowerBits)
     runtime_error(current_call_loc(),
                   "expt: the exact result would have more than 268435456 bits; use an inexact "
@@ -700,10 +712,12 @@ Value zero_base_expt(Value b, Value e) {
 } // namespace
 
 Value num_expt(Value base, Value exponent) {
+  if ((is_recnum(base) || is_recnum(exponent)) && is_number(base) && is_number(exponent))
+    return complex_expt(base, exponent);
   check_number(base, 1, "expt");
   check_number(exponent, 2, "expt");
   if (num_is_zero(base)) return zero_base_expt(base, exponent);
-  if (num_sign(base) < 0 && !is_integer(exponent)) complex_result("expt");
+  if (num_sign(base) < 0 && !is_integer(exponent)) return complex_expt(base, exponent);
   if (is_flonum(base)) return flonum_base_expt(base.d, exponent);
   if (is_flonum(exponent)) return Value::flonum(flonum_expt_general(to_double(base), exponent.d));
   if (is_exact_integer(exponent)) return exact_integer_expt(base, exponent);
@@ -711,8 +725,9 @@ Value num_expt(Value base, Value exponent) {
 }
 
 Value num_sqrt(Value a) {
+  if (is_recnum(a)) return complex_sqrt(a);
   check_number(a, 1, "sqrt");
-  if (num_sign(a) < 0) complex_result("sqrt");
+  if (num_sign(a) < 0) return complex_sqrt(a);
   if (is_flonum(a)) return Value::flonum(std::sqrt(a.d));
   if (auto root = exact_root(a, 2)) return *root;
   return Value::flonum(std::sqrt(to_double(a)));
@@ -740,53 +755,60 @@ double real_arg(Value a, const char *who) {
 }
 
 // asin and acos leave the reals outside [-1, 1].
-double unit_interval_arg(Value a, const char *who) {
+bool outside_unit_interval(Value a, const char *who) {
   double x = real_arg(a, who);
-  if (x < -1 || x > 1) complex_result(who);
-  return x;
+  return x < -1 || x > 1;
 }
 
 } // namespace
 
 Value num_exp(Value a) {
+  if (is_recnum(a)) return complex_exp(a);
   if (is_exact_zero(a)) return Value::fixnum(1);
   return Value::flonum(std::exp(real_arg(a, "exp")));
 }
 
 Value num_log(Value a) {
   if (is_exact_one(a)) return Value::fixnum(0);
+  if (is_recnum(a)) return complex_log(a);
   double x = real_arg(a, "log");
-  if (x < 0) complex_result("log");
+  if (x < 0) return complex_log(a);
   if (x == 0) divide_by_zero("log");
   return Value::flonum(std::log(x));
 }
 
 Value num_sin(Value a) {
+  if (is_recnum(a)) return complex_sin(a);
   if (is_exact_zero(a)) return a;
   return Value::flonum(std::sin(real_arg(a, "sin")));
 }
 
 Value num_cos(Value a) {
+  if (is_recnum(a)) return complex_cos(a);
   if (is_exact_zero(a)) return Value::fixnum(1);
   return Value::flonum(std::cos(real_arg(a, "cos")));
 }
 
 Value num_tan(Value a) {
+  if (is_recnum(a)) return complex_tan(a);
   if (is_exact_zero(a)) return a;
   return Value::flonum(std::tan(real_arg(a, "tan")));
 }
 
 Value num_asin(Value a) {
+  if (is_recnum(a) || outside_unit_interval(a, "asin")) return complex_asin(a);
   if (is_exact_zero(a)) return a;
-  return Value::flonum(std::asin(unit_interval_arg(a, "asin")));
+  return Value::flonum(std::asin(to_double(a)));
 }
 
 Value num_acos(Value a) {
+  if (is_recnum(a) || outside_unit_interval(a, "acos")) return complex_acos(a);
   if (is_exact_one(a)) return Value::fixnum(0);
-  return Value::flonum(std::acos(unit_interval_arg(a, "acos")));
+  return Value::flonum(std::acos(to_double(a)));
 }
 
 Value num_atan(Value a) {
+  if (is_recnum(a)) return complex_atan(a);
   if (is_exact_zero(a)) return a;
   return Value::flonum(std::atan(real_arg(a, "atan")));
 }
@@ -960,11 +982,8 @@ bool parse_prefixes(std::string_view &text, int &radix, char &exactness) {
   return true;
 }
 
-} // namespace
-
-std::optional<Value> parse_number(std::string_view text, int radix) {
-  char exactness = 0;
-  if (!parse_prefixes(text, radix, exactness)) return std::nullopt;
+// A real number with its #e or #i prefix applied.
+std::optional<Value> parse_real_part(std::string_view text, int radix, char exactness) {
   auto v = parse_real(text, radix, exactness);
   if (!v) return std::nullopt;
   if (exactness == 'i' && !is_flonum(*v)) return num_exact_to_inexact(*v);
@@ -973,6 +992,52 @@ std::optional<Value> parse_number(std::string_view text, int radix) {
     return num_inexact_to_exact(*v);
   }
   return v;
+}
+
+// Where the imaginary part of "x+yi" (without its i) begins: the last sign
+// that neither begins the text nor follows the exponent marker of a decimal.
+size_t imaginary_part_start(std::string_view s, int radix) {
+  for (size_t j = s.size(); j-- > 1;) {
+    if (s[j] != '+' && s[j] != '-') continue;
+    bool exponent = radix == 10 && (s[j - 1] == 'e' || s[j - 1] == 'E') && j >= 2 &&
+                    (std::isdigit(static_cast<unsigned char>(s[j - 2])) || s[j - 2] == '.');
+    if (!exponent) return j;
+  }
+  return s.empty() || (s[0] != '+' && s[0] != '-') ? std::string_view::npos : 0;
+}
+
+// The complex forms "x+yi", "x-i", "+yi", "-i" and "magnitude@angle", each
+// part a real number as parse_real reads it (with the prefixes applied).
+std::optional<Value> parse_complex(std::string_view s, int radix, char exactness) {
+  if (size_t at = s.find('@'); at != std::string_view::npos) {
+    auto magnitude = parse_real_part(s.substr(0, at), radix, exactness);
+    auto angle = parse_real_part(s.substr(at + 1), radix, exactness);
+    if (!magnitude || !angle) return std::nullopt;
+    return make_polar(*magnitude, *angle);
+  }
+  if (s.size() < 2 || (s.back() != 'i' && s.back() != 'I')) return std::nullopt;
+  s.remove_suffix(1);
+  size_t k = imaginary_part_start(s, radix);
+  if (k == std::string_view::npos) return std::nullopt;
+  std::string_view im_text = s.substr(k);
+  std::optional<Value> im;
+  if (im_text == "+" || im_text == "-") // an exact 1 even after #i, as MIT reads it
+    im = Value::fixnum(im_text == "+" ? 1 : -1);
+  else
+    im = parse_real_part(im_text, radix, exactness);
+  std::optional<Value> re = Value::fixnum(0);
+  if (k > 0) re = parse_real_part(s.substr(0, k), radix, exactness);
+  if (!re || !im) return std::nullopt;
+  return make_rectangular(*re, *im);
+}
+
+} // namespace
+
+std::optional<Value> parse_number(std::string_view text, int radix) {
+  char exactness = 0;
+  if (!parse_prefixes(text, radix, exactness)) return std::nullopt;
+  if (auto real = parse_real_part(text, radix, exactness)) return real;
+  return parse_complex(text, radix, exactness);
 }
 
 // ---- text: printing ----------------------------------------------------------------------
@@ -1015,6 +1080,7 @@ std::string number_to_string(Value v, int radix) {
   case Tag::Ratnum:
     return mpz_to_string(mpq_numref(rat(v)), radix) + "/" +
            mpz_to_string(mpq_denref(rat(v)), radix);
+  case Tag::Recnum: return complex_to_string(v, radix);
   default: wrong_type(v, 1, "number->string");
   }
 }

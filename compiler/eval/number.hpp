@@ -1,10 +1,15 @@
 // The numeric tower: exact integers of any size (int64 fixnums, GMP bignums),
-// exact rationals (GMP), and IEEE flonums, with MIT Scheme's rules:
+// exact rationals (GMP), IEEE flonums, and complex numbers whose parts are
+// any of those (recnums, complex.cpp), with MIT Scheme's rules:
 //   - results are normalized: an integral rational is an integer, an integer
 //     that fits in int64 is a fixnum;
 //   - exactness is contagious the usual way: exact op exact is exact, anything
 //     with a flonum is a flonum;
-//   - exact division by zero is an error ("Division by zero signalled by /.").
+//   - exact division by zero is an error ("Division by zero signalled by /.");
+//   - a recnum's imaginary part is never an exact zero (that number is real);
+//     operations that leave the reals (sqrt of a negative number, log of one,
+//     asin 2) give recnums; comparisons, rounding and integer operations take
+//     only real numbers.
 // Errors (wrong type, division by zero) are thrown with runtime_error() at
 // current_call_loc(), naming the procedure, as MIT does:
 //   "The object foo, passed as the first argument to integer-add, is not the correct type."
@@ -26,14 +31,18 @@ struct Bignum {
 struct Ratnum {
   mpq_t q; // canonical (lowest terms, positive denominator); cleared by a GC finalizer
 };
+struct Recnum {
+  Value re, im; // real numbers; im is not an exact 0
+};
 
 // ---- classification ----
-bool is_number(Value v);
-bool is_exact(Value v);          // fixnum, bignum, ratnum
+bool is_number(Value v);         // any number, complex included
+bool is_exact(Value v);          // fixnum, bignum, ratnum, recnum of exact parts
 bool is_exact_integer(Value v);  // fixnum, bignum
 bool is_exact_rational(Value v); // fixnum, bignum, ratnum
 bool is_integer(Value v);        // exact integer or integral finite flonum
-bool is_real(Value v);           // any number (no complex numbers here)
+bool is_real(Value v);           // a number that is not a recnum
+bool is_recnum(Value v);         // a complex number that is not real
 
 // ---- construction ----
 Value make_integer(const mpz_t z);  // normalizes to fixnum when it fits
@@ -44,6 +53,16 @@ double to_double(Value v); // any number -> nearest double
 std::optional<int64_t> to_int64(Value v);
 // Copy an exact integer or rational into q (q must be initialized).
 void to_mpq(Value v, mpq_t q);
+
+// ---- complex numbers (complex.cpp) ----
+// make-rectangular of two real numbers: re when im is an exact 0.
+Value make_rectangular(Value re, Value im);
+Value make_polar(Value magnitude, Value angle); // (make-polar 1 0) is exact 1
+Value num_real_part(Value z);
+Value num_imag_part(Value z); // exact 0 for a real
+Value num_magnitude(Value z); // exact for exact parts with a perfect-square norm
+Value num_angle(Value z);     // exact 0 for a non-negative exact real
+Value num_conjugate(Value z);
 
 // ---- arithmetic (arguments must be numbers; `who` names the procedure in errors) ----
 Value num_add(Value a, Value b);
@@ -77,8 +96,8 @@ Value num_inexact_to_exact(Value a); // a flonum becomes the exact rational it d
 // rationals); exact rational base with exact rational exponent gives an exact
 // result when it is one ((expt 4 1/2) = 2), otherwise flonum.
 Value num_expt(Value base, Value exponent);
-// sqrt: exact for exact perfect squares (integers and rationals), else flonum.
-// A negative argument is an error (sicm has no complex numbers).
+// sqrt: exact for exact perfect squares (integers and rationals), else flonum;
+// a negative or complex argument has its principal root ((sqrt -4) is +2i).
 Value num_sqrt(Value a);
 // (exact-integer-sqrt n): s and r with s^2 + r = n.
 std::pair<Value, Value> num_exact_integer_sqrt(Value n);
@@ -96,11 +115,11 @@ Value num_atan2(Value y, Value x); // (atan 0 1) is exact 0
 // ---- text ----
 // Parse a numeric literal as the reader sees it: "42", "-5/128", ".5", "1.",
 // "1e-13", "-1.5987211554602254e-14", "#x1F", "#e1.5", "#i1/3", "+inf.0",
-// "-inf.0", "+nan.0". Returns nullopt if text is not a number (then the reader
-// treats it as a symbol).
+// "-inf.0", "+nan.0", "1+2i", "-i", "1.5e3-2/3i", "2@1.5" (polar). Returns nullopt if text is not a
+// number (then the reader treats it as a symbol).
 std::optional<Value> parse_number(std::string_view text, int radix = 10);
 // MIT Scheme's printed form: "42", "1/2", "435.", ".7518269446689928",
-// "-1.5987211554602254e-14", "+inf.0", "+nan.0".
+// "-1.5987211554602254e-14", "+inf.0", "+nan.0", "1+2i", "+i", "1.5-2.i".
 std::string number_to_string(Value v, int radix = 10);
 
 // The primitives of this module (+ - * / = < > <= >= max min quotient

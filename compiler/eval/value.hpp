@@ -46,6 +46,7 @@ enum class Tag : uint8_t {
   // heap objects
   Bignum,    // exact integer outside int64_t (GMP mpz)
   Ratnum,    // exact non-integer rational (GMP mpq), always in lowest terms
+  Recnum,    // a complex number that is not real: two real parts (eval/number.hpp)
   Symbol,    // interned
   String,    // mutable byte string (UTF-8)
   Pair,      // cons cell

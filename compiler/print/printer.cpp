@@ -105,7 +105,8 @@ void print_value(std::string &out, Value v, bool display) {
   case Tag::Fixnum:
   case Tag::Flonum:
   case Tag::Bignum:
-  case Tag::Ratnum: out += number_to_string(v); return;
+  case Tag::Ratnum:
+  case Tag::Recnum: out += number_to_string(v); return;
   case Tag::Symbol: {
     // Uninterned symbols print by name too, as MIT does.
     const std::string &name = symbol_name(v);
