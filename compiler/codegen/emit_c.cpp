@@ -45,8 +45,8 @@
 #include "algebra/symbolic.hpp"
 #include "codegen/jit.hpp"
 #include "eval/number.hpp"
-#include "syntax/error.hpp"
 #include "sicm/runtime.h"
+#include "syntax/error.hpp"
 
 namespace sicm {
 
@@ -107,11 +107,14 @@ bool has_operands(ExprId id) {
 class Emitter {
 public:
   // spell gives the C text of a symbol (an atom); temporaries are named
-  // temp_prefix followed by a number.
+  // temp_prefix followed by a number. With a checked_site (a C expression
+  // of type const sicm_site *), division, sqrt, log, asin, acos and pow
+  // call the runtime's checked forms, which fail there as the interpreter
+  // would instead of giving an infinity or a NaN.
   Emitter(std::vector<ExprId> outputs, std::function<std::string(Symbol *)> spell,
-          std::string temp_prefix = "t")
+          std::string temp_prefix = "t", std::string checked_site = "")
       : outputs_(std::move(outputs)), spell_(std::move(spell)),
-        temp_prefix_(std::move(temp_prefix)) {
+        temp_prefix_(std::move(temp_prefix)), checked_site_(std::move(checked_site)) {
     find_exact_zeros();
     collect();
     plan();
@@ -220,8 +223,8 @@ private:
       mpq_t q;
       mpq_init(q);
       to_mpq(v, q);
-      bool fits = mpz_sizeinbase(mpq_numref(q), 2) + mpz_sizeinbase(mpq_denref(q), 2) <=
-                  kMaxConstantBits;
+      bool fits =
+          mpz_sizeinbase(mpq_numref(q), 2) + mpz_sizeinbase(mpq_denref(q), 2) <= kMaxConstantBits;
       mpq_clear(q);
       return fits;
     };
@@ -522,8 +525,7 @@ private:
         numerator.push_back(ref(args[i]));
     }
     Code c = numerator.empty() ? Code{"1.0", kAtom} : product(numerator);
-    if (!denominator.empty())
-      c = {wrap(c, kMul) + " / " + wrap(product(denominator), kUnary), kMul};
+    if (!denominator.empty()) c = quotient("expt", c, product(denominator));
     if (negate) return {"-" + wrap(c, kAtom), kUnary};
     return c;
   }
@@ -585,6 +587,22 @@ private:
     return {s + ")", kAtom};
   }
 
+  // The runtime's checked form of fn ("sqrt" -> sicm_checked_sqrt(site, x)).
+  Code checked_call(const char *fn, const std::vector<ExprId> &args) {
+    std::string s = std::string("sicm_checked_") + fn + "(" + checked_site_;
+    for (ExprId a : args)
+      s += ", " + ref(a).text;
+    return {s + ")", kAtom};
+  }
+
+  // a / b, checked when the emitter is.
+  Code quotient(const std::string &who, const Code &a, const Code &b) {
+    if (checked_site_.empty()) return {wrap(a, kMul) + " / " + wrap(b, kUnary), kMul};
+    return {"sicm_checked_quotient(" + checked_site_ + ", \"" + who + "\", " + a.text + ", " +
+                b.text + ")",
+            kAtom};
+  }
+
   // An operation node written out in full (its arguments by ref).
   Code inline_form(ExprId id) {
     if (zeros_.count(id)) return literal(0.0); // see find_exact_zeros
@@ -601,30 +619,34 @@ private:
       return {s, kAdd};
     }
     case Op::Div: {
-      if (args.size() == 1) return {"1.0 / " + wrap(ref(args[0]), kUnary), kMul};
-      std::string s = wrap(ref(args[0]), kMul);
+      if (args.size() == 1) return quotient("/", {"1.0", kAtom}, ref(args[0]));
+      Code q = ref(args[0]);
       for (size_t i = 1; i < args.size(); ++i)
-        s += " / " + wrap(ref(args[i]), kUnary);
-      return {s, kMul};
+        q = quotient("/", q, ref(args[i]));
+      return q;
     }
     case Op::Expt: {
       int64_t n;
-      if (!integer_power(id, &n)) return call("pow", args);
+      if (!integer_power(id, &n))
+        return checked_site_.empty() ? call("pow", args) : checked_call("pow", args);
       if (n == 0) return {"1.0", kAtom};
       uint64_t m = n < 0 ? 0 - static_cast<uint64_t>(n) : static_cast<uint64_t>(n);
       Code p = power(args[0], m);
       if (n > 0) return p;
-      return {"1.0 / " + wrap(p, kAtom), kMul};
+      return quotient("expt", {"1.0", kAtom}, p);
     }
     case Op::Atan: return call(args.size() == 2 ? "atan2" : "atan", args);
     case Op::Sqrt:
-    case Op::Exp:
     case Op::Log:
+    case Op::Asin:
+    case Op::Acos:
+      SICM_ASSERT(args.size() == 1);
+      if (!checked_site_.empty()) return checked_call(op_info(op).c_name, args);
+      return call(op_info(op).c_name, args);
+    case Op::Exp:
     case Op::Sin:
     case Op::Cos:
     case Op::Tan:
-    case Op::Asin:
-    case Op::Acos:
     case Op::Sinh:
     case Op::Cosh:
     case Op::Abs: SICM_ASSERT(args.size() == 1); return call(op_info(op).c_name, args);
@@ -635,6 +657,7 @@ private:
   std::vector<ExprId> outputs_;
   std::function<std::string(Symbol *)> spell_;
   std::string temp_prefix_;
+  std::string checked_site_;  // empty: plain C operations (kernels)
   std::vector<ExprId> nodes_; // reachable from the outputs, increasing ids
   std::unordered_map<ExprId, uint32_t> uses_;
   std::unordered_set<ExprId> wants_name_;
@@ -746,8 +769,9 @@ std::string emit_kernel_function(const Trace &t, const std::string &c_name, bool
 std::string emit_c_assignments(const std::vector<ExprId> &values,
                                const std::vector<std::string> &targets,
                                const std::function<std::string(Symbol *)> &spell,
-                               const std::string &temp_prefix, const std::string &indent) {
-  return Emitter(values, spell, temp_prefix).assignments(targets, indent);
+                               const std::string &temp_prefix, const std::string &indent,
+                               const std::string &checked_site) {
+  return Emitter(values, spell, temp_prefix, checked_site).assignments(targets, indent);
 }
 
 bool uses_linear_solve(const std::vector<ExprId> &outputs) {

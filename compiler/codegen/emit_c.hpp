@@ -30,11 +30,16 @@ std::string emit_kernel_unit(const Trace &t, const std::string &c_name,
 // into the C lvalue targets[j], with CSE across all the values. A symbol is
 // written as spell(symbol) (an atom: a name or an array element);
 // temporaries are declared as temp_prefix followed by a number, so two
-// calls with different prefixes can share a C block.
+// calls with different prefixes can share a C block. With a checked_site
+// (the C text of a const sicm_site *), division, sqrt, log, asin, acos and
+// pow are the runtime's sicm_checked_ forms, which fail at that site where
+// the interpreter raises an error or leaves the reals (the residual
+// program's own arithmetic); kernels pass none.
 std::string emit_c_assignments(const std::vector<ExprId> &values,
                                const std::vector<std::string> &targets,
                                const std::function<std::string(Symbol *)> &spell,
-                               const std::string &temp_prefix, const std::string &indent);
+                               const std::string &temp_prefix, const std::string &indent,
+                               const std::string &checked_site = "");
 
 // Does any output depend on a solve node (algebra/linear_solve.hpp)?
 bool uses_linear_solve(const std::vector<ExprId> &outputs);

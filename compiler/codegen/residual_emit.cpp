@@ -297,16 +297,32 @@ private:
     return var_name(v);
   }
 
+  // The program's own arithmetic (emit_c_assignments' checked form): values
+  // into targets, failing at loc where the interpreter would raise an error
+  // or leave the reals. A site is made only for code that uses one.
+  std::string checked_assignments(const std::vector<ExprId> &values,
+                                  const std::vector<std::string> &targets,
+                                  const std::string &temp_prefix, const SrcLoc &loc) {
+    static const std::string kPlaceholder = "sicm_checked_site_placeholder";
+    std::string code = emit_c_assignments(
+        values, targets, [this](Symbol *s) { return spell(s); }, temp_prefix, "", kPlaceholder);
+    size_t at = code.find(kPlaceholder);
+    if (at == std::string::npos) return code;
+    std::string where = site(loc);
+    for (; at != std::string::npos; at = code.find(kPlaceholder, at + where.size()))
+      code.replace(at, kPlaceholder.size(), where);
+    return code;
+  }
+
   // Statements computing exprs into new constants; their names.
   std::vector<std::string> operands(const std::vector<ExprId> &exprs, const std::string &prefix,
-                                    std::string &code) {
+                                    const SrcLoc &loc, std::string &code) {
     std::vector<std::string> names, targets;
     for (size_t i = 0; i < exprs.size(); ++i) {
       names.push_back(prefix + "a" + std::to_string(i));
       targets.push_back("double " + names.back());
     }
-    code += emit_c_assignments(
-        exprs, targets, [this](Symbol *s) { return spell(s); }, prefix + "t", "");
+    code += checked_assignments(exprs, targets, prefix + "t", loc);
     return names;
   }
 
@@ -378,7 +394,7 @@ private:
   std::string statement(int f, const RStmt &s) {
     std::string prefix = "s" + std::to_string(nstatements_++) + "_";
     std::string code;
-    auto args = [&] { return operands(s.args, prefix, code); };
+    auto args = [&] { return operands(s.args, prefix, s.loc, code); };
     switch (s.kind) {
     case RKind::Text: code += "sicm_print_text(" + c_string_literal(s.text) + ");\n"; break;
     case RKind::Print: {
@@ -392,8 +408,18 @@ private:
     case RKind::Let: {
       std::string v = decl(f, s.var);
       if (s.compute == RCompute::Expr) {
-        code += emit_c_assignments(
-            s.args, {v}, [this](Symbol *x) { return spell(x); }, prefix + "t", "");
+        code += checked_assignments(s.args, {v}, prefix + "t", s.loc);
+        break;
+      }
+      if (s.compute == RCompute::Select) {
+        // Only the chosen arm is computed, as the interpreter's if computes
+        // it: the other may divide by zero or leave the reals.
+        std::vector<std::string> test = operands({s.args[0]}, prefix, s.loc, code);
+        if (v != var_name(s.var)) code += v + ";\n";
+        code += "if (" + test[0] + " != 0.0) {\n" +
+                checked_assignments({s.args[1]}, {var_name(s.var)}, prefix + "y", s.loc) +
+                "} else {\n" +
+                checked_assignments({s.args[2]}, {var_name(s.var)}, prefix + "n", s.loc) + "}\n";
         break;
       }
       std::vector<std::string> a = args();
@@ -403,7 +429,7 @@ private:
       case RCompute::Less: e = "(" + a[0] + " < " + a[1] + ") ? 1.0 : 0.0"; break;
       case RCompute::LessEq: e = "(" + a[0] + " <= " + a[1] + ") ? 1.0 : 0.0"; break;
       case RCompute::Equal: e = "(" + a[0] + " == " + a[1] + ") ? 1.0 : 0.0"; break;
-      case RCompute::Select: e = a[0] + " != 0.0 ? " + a[1] + " : " + a[2]; break;
+      case RCompute::Select: break; // above
       case RCompute::Not: e = a[0] + " == 0.0 ? 1.0 : 0.0"; break;
       case RCompute::Floor: e = "floor(" + a[0] + ")"; break;
       case RCompute::Round: e = "nearbyint(" + a[0] + ")"; break;
@@ -653,7 +679,7 @@ private:
       if (s.kind == RKind::Loop) {
         std::string init;
         std::vector<std::string> a =
-            operands(s.args, "s" + std::to_string(nstatements_++) + "_", init);
+            operands(s.args, "s" + std::to_string(nstatements_++) + "_", s.loc, init);
         for (size_t i = 0; i < s.outs.size(); ++i)
           init += var_name(s.outs[i]) + " = " + a[i] + ";\n";
         code += indent(init, depth);
@@ -673,7 +699,7 @@ private:
       if (then_code.empty() && else_code.empty()) continue;
       std::string test;
       std::vector<std::string> t =
-          operands(s.args, "s" + std::to_string(nstatements_++) + "_", test);
+          operands(s.args, "s" + std::to_string(nstatements_++) + "_", s.loc, test);
       code += indent(test, depth);
       if (then_code.empty()) {
         code += indent("if (" + t[0] + " == 0.0) {", depth) + else_code;
@@ -710,8 +736,7 @@ private:
       std::vector<std::string> targets;
       for (size_t j = 0; j < fn.outputs.size(); ++j)
         targets.push_back("out[" + std::to_string(j) + "]");
-      code += emit_c_assignments(
-          fn.outputs, targets, [this](Symbol *s) { return spell(s); }, "o", "");
+      code += checked_assignments(fn.outputs, targets, "o", fn.loc);
     }
     return code + "}\n\n";
   }

@@ -163,7 +163,10 @@ static char *failure_text(const sicm_site *site, const char *who, const char *re
   size_t size = 0;
   FILE *f = open_memstream(&text, &size);
   if (!f) return NULL;
-  fprintf(f, "%s: error: %s: %s\n", site->where, who, reason);
+  if (who)
+    fprintf(f, "%s: error: %s: %s\n", site->where, who, reason);
+  else
+    fprintf(f, "%s: error: %s\n", site->where, reason);
   if (site->line && site->line[0]) {
     fprintf(f, "  %s\n  ", site->line);
     for (int i = 1; i < site->col; ++i)
@@ -196,7 +199,7 @@ void sicm_program_fail(const sicm_site *site, const char *who, const char *reaso
   if (!message) {
     /* No memory for the text: write it piece by piece. */
     fflush(stdout);
-    if (!quiet) fprintf(stderr, "%s: error: %s: %s\n", site->where, who, reason);
+    if (!quiet) fprintf(stderr, "%s: error: %s: %s\n", site->where, who ? who : "", reason);
     exit_failed();
   }
   sicm_program_fail_message(message);

@@ -58,7 +58,8 @@ void sicm_program_init(int argc, char **argv, const char *program_name,
  * the default. */
 double sicm_program_param(const char *name, double fallback);
 
-/* sicm_program_fail prints "WHERE: error: WHO: REASON", the source line and
+/* sicm_program_fail prints "WHERE: error: WHO: REASON" ("WHERE: error:
+ * REASON" when WHO is NULL), the source line and
  * a caret on stderr, finishes every plot and exits with status 70. Inside a
  * member of a parallel sweep it ends the member instead, and the sweep
  * reports it in its turn (see sicm_parallel_map). */
@@ -67,6 +68,22 @@ void sicm_program_fail(const sicm_site *site, const char *who, const char *reaso
     __attribute__((noreturn))
 #endif
     ;
+
+/* The operations of the program's own arithmetic (not of kernels) that
+ * sicm run would not answer with a real number: they fail at `site` as the
+ * interpreter does where it raises an error (division by zero: "Division by
+ * zero signalled by WHO.") and say that the result is complex where the
+ * interpreter leaves the reals (sqrt and log of a negative number, asin and
+ * acos outside [-1, 1], a negative number to a non-integer power), since
+ * compiled code computes with real numbers. Otherwise they are a / b,
+ * sqrt(x), log(x), asin(x), acos(x) and pow(x, y). `who` names the procedure
+ * ("/" or "expt"). */
+double sicm_checked_quotient(const sicm_site *site, const char *who, double a, double b);
+double sicm_checked_sqrt(const sicm_site *site, double x);
+double sicm_checked_log(const sicm_site *site, double x);
+double sicm_checked_asin(const sicm_site *site, double x);
+double sicm_checked_acos(const sicm_site *site, double x);
+double sicm_checked_pow(const sicm_site *site, double x, double y);
 
 /* Printing, as the compiler prints: text as it is, a real in MIT Scheme's
  * shortest round-trip form ("435.", ".5", "-1.5e-14"), an integer (given as
