@@ -34,6 +34,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <map>
@@ -595,9 +596,19 @@ private:
     return {s + ")", kAtom};
   }
 
-  // a / b, checked when the emitter is.
+  // Is c a number literal other than zero ("6.283185307179586", "-2.0")?
+  static bool nonzero_literal(const Code &c) {
+    const char *text = c.text.c_str();
+    char *end = nullptr;
+    double value = std::strtod(text, &end);
+    return end != text && *end == '\0' && value != 0;
+  }
+
+  // a / b, checked when the emitter is (unless b is a nonzero literal: the
+  // 2pi of a map's angles costs nothing).
   Code quotient(const std::string &who, const Code &a, const Code &b) {
-    if (checked_site_.empty()) return {wrap(a, kMul) + " / " + wrap(b, kUnary), kMul};
+    if (checked_site_.empty() || nonzero_literal(b))
+      return {wrap(a, kMul) + " / " + wrap(b, kUnary), kMul};
     return {"sicm_checked_quotient(" + checked_site_ + ", \"" + who + "\", " + a.text + ", " +
                 b.text + ")",
             kAtom};
