@@ -258,7 +258,7 @@ Value P_find_root(Value *a, int n) {
   return r;
 }
 
-Value P_bisect(Value *a, int n) {
+Value bisect_at_run_time(Value *a, int n) {
   static const char who[] = "bisect";
   RStmt s{RKind::Bisect};
   s.loc = here();
@@ -269,6 +269,30 @@ Value P_bisect(Value *a, int n) {
   s.outs = {var_of(r)};
   emit(std::move(s));
   return r;
+}
+
+// bisect with a function that cannot be compiled (it builds streams, or
+// lists that it mutates, as the book's which-way? of section 4.6.1 does) but
+// with every number known now: the interpreter's bisect computes the root
+// while compiling, as sicm run computes it, and the program keeps the number.
+// A function that reads run-time values cannot be evaluated now either, and
+// the error is the compiler's.
+Value P_bisect(Value *a, int n) {
+  bool known = is_number(a[1]) && is_number(a[2]) && is_number(a[3]) &&
+               (n < 5 || a[4].is(Tag::Default) || is_number(a[4]));
+  ProgramMark mark = mark_program();
+  try {
+    return bisect_at_run_time(a, n);
+  } catch (const Error &e) {
+    if (!known || !is_cannot_compile(e)) throw;
+    rewind_program(mark);
+    Error why = e;
+    try {
+      return call_original("bisect", a, n);
+    } catch (const Error &) {
+      throw why;
+    }
+  }
 }
 
 Value P_not_yet(Value *, int) {

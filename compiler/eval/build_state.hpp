@@ -109,6 +109,15 @@ void set_cell(int cell, Value v);
 void read_cells();
 // Run a numerical primitive, tracing it again on Retrace.
 Value with_retrace(const std::function<Value()> &body);
+// How far the program had got (functions, variables, statements of the
+// current function), and going back there to abandon a trace.
+struct ProgramMark {
+  size_t nfunctions, nvars, nbody;
+};
+ProgramMark mark_program();
+void rewind_program(const ProgramMark &mark);
+// Is e cannot_compile's error?
+bool is_cannot_compile(const Error &e);
 // A new variable of the given type computed by c from args.
 Value let(RCompute c, std::vector<ExprId> args, RType type);
 

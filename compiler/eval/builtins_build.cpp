@@ -319,26 +319,33 @@ void read_cells() {
 
 // Run a numerical primitive, tracing it again whenever a traced procedure
 // turns a global into a cell (or widens a cell from counts to reals).
+ProgramMark mark_program() {
+  return {g_prog->functions.size(), g_prog->vars.size(), current().body.size()};
+}
+
+void rewind_program(const ProgramMark &mark) {
+  for (size_t v = mark.nvars; v < g_prog->vars.size(); ++v)
+    g_var_of.erase(g_prog->vars[v].sym);
+  g_prog->functions.resize(mark.nfunctions);
+  g_prog->vars.resize(mark.nvars);
+  std::vector<RStmt> &body = current().body;
+  body.erase(body.begin() + static_cast<long>(mark.nbody), body.end());
+}
+
 Value with_retrace(const std::function<Value()> &body) {
   size_t depth = g_open.size();
   if (depth != 1) return body(); // the outermost primitive retraces
-  size_t nfunctions = g_prog->functions.size(), nvars = g_prog->vars.size();
   // The primitive's call site: tracing its procedures moves the evaluator's
   // idea of the current call into them, and a retrace must not take that
   // for the primitive's place (its errors and sites name the call).
   const SrcLoc call = current_call_loc();
   for (;;) {
-    size_t nbody = current().body.size();
+    ProgramMark mark = mark_program();
     reset_call_loc(call);
     try {
       return body();
     } catch (const Retrace &) {
-      for (size_t v = nvars; v < g_prog->vars.size(); ++v)
-        g_var_of.erase(g_prog->vars[v].sym);
-      g_prog->functions.resize(nfunctions);
-      g_prog->vars.resize(nvars);
-      std::vector<RStmt> &main_body = current().body;
-      main_body.erase(main_body.begin() + static_cast<long>(nbody), main_body.end());
+      rewind_program(mark);
       for (size_t i = 0; i < g_prog->cells.size(); ++i) {
         if (g_cell_initialized[i]) continue;
         g_cell_initialized[i] = true;
@@ -347,6 +354,10 @@ Value with_retrace(const std::function<Value()> &body) {
       init_list_cells();
     }
   }
+}
+
+bool is_cannot_compile(const Error &e) {
+  return e.kind == ErrorKind::Syntax && std::string_view(e.what()).starts_with("cannot compile: ");
 }
 
 Value let(RCompute c, std::vector<ExprId> args, RType type) {
