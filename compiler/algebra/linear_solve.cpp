@@ -9,13 +9,13 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "eval/number.hpp"
+#include "eval/primitive.hpp"
 
 namespace sicm {
 
 namespace {
 
 thread_local int g_kernel_tracing = 0;
-bool (*g_is_run_time)(Value) = nullptr;
 
 // A component that can stand in an expression: a number, a symbol or an
 // expression (not a structure, a differential, a function).
@@ -68,12 +68,13 @@ template <typename Entry> bool wants_solve(size_t n, Entry entry) {
 // Is the n x n matrix entry(i, j) made of numbers and run-time values, at
 // least one of them a run-time value, outside a kernel in sicm build?
 template <typename Entry> bool wants_interpreted_solve(size_t n, Entry entry) {
-  if (g_kernel_tracing != 0 || !g_is_run_time) return false;
+  RunTimeValueTest is_run_time = run_time_value_test();
+  if (g_kernel_tracing != 0 || !is_run_time) return false;
   bool run_time = false;
   for (size_t i = 0; i < n; ++i)
     for (size_t j = 0; j < n; ++j) {
       Value e = entry(i, j);
-      if (!is_number(e) && !g_is_run_time(e)) return false;
+      if (!is_number(e) && !is_run_time(e)) return false;
       run_time = run_time || !is_number(e);
     }
   return run_time;
@@ -81,7 +82,8 @@ template <typename Entry> bool wants_interpreted_solve(size_t n, Entry entry) {
 
 bool all_numbers_or_run_time(const Structure *s) {
   for (size_t i = 0; i < s->len; ++i)
-    if (!is_number(s->items[i]) && !(g_is_run_time && g_is_run_time(s->items[i]))) return false;
+    if (!is_number(s->items[i]) && !(run_time_value_test() && run_time_value_test()(s->items[i])))
+      return false;
   return true;
 }
 
@@ -226,10 +228,6 @@ ExprId interpreted_solve_head() {
   return expr_symbol(head.symbol());
 }
 
-void set_run_time_value_test(bool (*is_run_time)(Value)) {
-  g_is_run_time = is_run_time;
-}
-
 bool is_solve_node(ExprId id) {
   if (expr_kind(id) != ExprKind::Call) return false;
   ExprId head = expr_node(id).head;
@@ -270,7 +268,7 @@ ExprId solve_rhs_entry(ExprId id, size_t i) {
 // result then has the dual of s's outer orientation. Other combinations
 // do not contract and are left to the general path.
 std::optional<Value> traced_structure_solve(Value a, Value s) {
-  if ((g_kernel_tracing == 0 && !g_is_run_time) || !is_structure(a) || !is_structure(s))
+  if ((g_kernel_tracing == 0 && !run_time_value_test()) || !is_structure(a) || !is_structure(s))
     return std::nullopt;
   Structure *st = as_structure(s), *av = as_structure(a);
   size_t n = st->len;
@@ -294,7 +292,7 @@ std::optional<Value> traced_structure_solve(Value a, Value s) {
 
 // (/ a m) with a an up is m^-1 a, an up (matrix_div and matrix_times_up).
 std::optional<Value> traced_matrix_solve(Value a, Value m) {
-  if ((g_kernel_tracing == 0 && !g_is_run_time) || !is_structure(a) || !is_matrix(m))
+  if ((g_kernel_tracing == 0 && !run_time_value_test()) || !is_structure(a) || !is_matrix(m))
     return std::nullopt;
   Matrix *mm = as_matrix(m);
   Structure *av = as_structure(a);

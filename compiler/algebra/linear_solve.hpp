@@ -59,9 +59,9 @@ ExprId solve_head();
 // instead, which the C emitter writes as a call of
 // sicm_linalg_solve_as_interpreted (sicm/linalg.h): Gauss-Jordan with the
 // interpreter's pivoting and order of operations. Build mode says which
-// values are run-time values; without it (sicm run) there are none.
+// values are run-time values (run_time_value_test, eval/primitive.hpp);
+// without it (sicm run) there are none.
 ExprId interpreted_solve_head();
-void set_run_time_value_test(bool (*is_run_time)(Value));
 
 // Is id a solve node (of either head)? Its dimension n, component k, and
 // entries.

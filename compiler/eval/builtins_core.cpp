@@ -36,13 +36,40 @@ const char *ordinal(int n) {
 }
 } // namespace
 
+namespace {
+
+RunTimeValueTest g_run_time_value_test = nullptr;
+
+// A primitive that only sicm run computes, given a value known only at run
+// time by sicm build.
+void refuse_run_time_argument(Value obj, int argpos, const char *who) {
+  if (!g_run_time_value_test || !g_run_time_value_test(obj)) return;
+  throw Error(ErrorKind::Syntax, current_call_loc(),
+              std::string("cannot compile: ") + who + " of a number known only at run time (its " +
+                  ordinal(argpos) + " argument)",
+              "sicm build leaves only numerical work for run time; `sicm run` interprets this "
+              "program");
+}
+
+} // namespace
+
+void set_run_time_value_test(RunTimeValueTest test) {
+  g_run_time_value_test = test;
+}
+
+RunTimeValueTest run_time_value_test() {
+  return g_run_time_value_test;
+}
+
 void wrong_type(Value obj, int argpos, const char *who) {
+  refuse_run_time_argument(obj, argpos, who);
   runtime_error(current_call_loc(), "The object " + write_string(obj) + ", passed as the " +
                                         ordinal(argpos) + " argument to " + who +
                                         ", is not the correct type.");
 }
 
 void bad_range(Value obj, int argpos, const char *who) {
+  refuse_run_time_argument(obj, argpos, who);
   runtime_error(current_call_loc(), "The object " + write_string(obj) + ", passed as the " +
                                         ordinal(argpos) + " argument to " + who +
                                         ", is not in the correct range.");

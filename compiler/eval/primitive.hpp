@@ -25,6 +25,14 @@ void define_primitive(const char *name, int min_args, int max_args, PrimFn fn);
 // Bind `name` to an existing value (constants such as pi, aliases).
 void define_global(const char *name, Value v);
 
+// sicm build says which values are known only at run time (no test in sicm
+// run): an argument error on one of them is the compiler's "cannot compile"
+// error (the value may well be right at run time), and algebra/
+// linear_solve.cpp solves with them as the interpreter would.
+using RunTimeValueTest = bool (*)(Value);
+void set_run_time_value_test(RunTimeValueTest test);
+RunTimeValueTest run_time_value_test(); // null outside sicm build
+
 // MIT-style argument errors, raised at current_call_loc(). argpos is 1-based.
 //   "The object (), passed as the first argument to car, is not the correct type."
 [[noreturn]] void wrong_type(Value obj, int argpos, const char *who);
