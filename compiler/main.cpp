@@ -361,10 +361,12 @@ void *evaluator_thread(void *arg) {
     sicm::flush_output();
     sicm::Error shown = e;
     sicm::SrcLoc user = sicm::current_toplevel_loc();
-    if (sicm::is_library_loc(e.loc) && user.known() && shown.note.empty())
-      shown.note = "raised inside the library while evaluating " + sicm::source_name(user.file) +
-                   ":" + std::to_string(user.line) + ":" + std::to_string(user.col) + ": " +
-                   std::string(sicm::source_line(user.file, user.line));
+    if (sicm::is_library_loc(e.loc) && user.known()) {
+      // The user's form that led there comes first, the library's place in a note.
+      shown.loc = user;
+      shown.note = "raised inside the library, at " + sicm::loc_text(e.loc) +
+                   (e.note.empty() ? "" : "\nnote: " + e.note);
+    }
     sicm::report_error(stderr, shown);
     job->status = e.exit_code();
   } catch (const std::bad_alloc &) {
