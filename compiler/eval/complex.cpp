@@ -188,7 +188,7 @@ Value complex_sqrt(Value z) {
 // b^e for a complex base or exponent, or a negative real base with a
 // non-integer exponent: exact integer exponents by repeated squaring (exact
 // parts stay exact: (expt 1+i 2) is +2i), anything else as e^(e log b), as
-// MIT: (expt -1 1/2) is 6.123233995736766e-17+i, not (sqrt -1) = +i.
+// MIT: (expt -1 1/2) is 6.123233995736766e-17+1.i, not (sqrt -1) = +i.
 Value complex_expt(Value b, Value e) {
   if (is_exact_integer(e)) {
     bool negative = num_sign(e) < 0;
