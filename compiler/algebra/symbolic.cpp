@@ -340,6 +340,8 @@ Value P_simplify(Value *a, int) {
   return simplify_value(a[0]);
 }
 
+// print-expression and pe write the simplified form on one line: the book's
+// results are read and compared line by line (pp breaks long forms).
 Value P_print_expression(Value *a, int) {
   output(write_string(simplify_value(a[0])));
   output("\n");

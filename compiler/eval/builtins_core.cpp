@@ -11,6 +11,7 @@
 #include "eval/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
+#include "print/pretty.hpp"
 #include "print/printer.hpp"
 
 namespace sicm {
@@ -236,7 +237,7 @@ Value P_write_line(Value *a, int) {
   return Value::unspecified();
 }
 Value P_pp(Value *a, int) {
-  output(write_string(a[0]));
+  output(pretty_string(a[0]));
   output("\n");
   return Value::unspecified();
 }
