@@ -1,4 +1,4 @@
-// The pretty-printer of pp, pe and print-expression (see pretty.hpp for the rules).
+// The pretty-printer of pp (see pretty.hpp for the rules).
 #include "print/pretty.hpp"
 
 #include <cstring>

@@ -1,4 +1,4 @@
-// The pretty-printer of pp, pe and print-expression: a value's written form
+// The pretty-printer of pp: a value's written form
 // broken into lines of at most `width` characters as MIT Scheme's pp breaks
 // data and expressions:
 //   - a list that fits on the rest of its line is written there;
