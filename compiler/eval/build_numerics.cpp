@@ -295,8 +295,20 @@ Value P_bisect(Value *a, int n) {
   }
 }
 
-Value P_not_yet(Value *, int) {
-  cannot_compile(here(), "this numerical primitive is not compiled yet");
+// nelder-mead is not compiled for run time. With every number it needs
+// known now, the interpreter's nelder-mead computes the minimum while
+// compiling, as sicm run computes it (an error of the program is raised as
+// sicm run raises it); a function that reads run-time values cannot be.
+Value P_nelder_mead(Value *a, int n) {
+  ProgramMark mark = mark_program();
+  try {
+    return call_original("nelder-mead", a, n);
+  } catch (const Error &e) {
+    if (!is_cannot_compile(e)) throw;
+    rewind_program(mark);
+    cannot_compile(here(), "nelder-mead is not compiled for run time, and its function reads "
+                           "values known only at run time");
+  }
 }
 
 // The integrator of argument i (or *ode-integration-method*) as the
@@ -539,7 +551,7 @@ void rebind_numerical_primitives() {
   rebind("brent-min", 3, 4, retrying<P_minimize<kBrentMin>>);
   rebind("multidimensional-minimize", 2, 3, retrying<P_multidimensional_minimize>);
   rebind("find-root", 3, 4, retrying<P_find_root>);
-  rebind("nelder-mead", 2, 5, P_not_yet);
+  rebind("nelder-mead", 2, 5, P_nelder_mead);
   rebind("bisect", 4, 5, retrying<P_bisect>);
   rebind("state-advancer", 1, kVariadic, P_state_advancer);
   rebind("evolve", 1, kVariadic, P_evolve);

@@ -178,6 +178,10 @@ struct ScalarCallback : Callback {
 
 // The procedure's value as a double; a non-number is an error.
 double real_result(const Callback &cb, Value r, const std::string &at) {
+  // In sicm build (computing while compiling) a value known only at run
+  // time is the compiler's "cannot compile" error (see wrong_type).
+  if (RunTimeValueTest run_time = run_time_value_test(); run_time && run_time(r))
+    wrong_type(r, 1, cb.who);
   if (!is_number(r))
     runtime_error(cb.loc, std::string(cb.who) + ": the function returned " + write_string(r) +
                               " at " + at + ", which is not a real number");
