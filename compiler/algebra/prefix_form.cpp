@@ -5,7 +5,9 @@
 // Other expressions print faithfully too: a product with negative integer
 // powers becomes a quotient, (expt x -1) becomes (/ 1 x), so an unsimplified
 // expression never shows an exponent the user did not write.
+#include <algorithm>
 #include <unordered_map>
+#include <vector>
 
 #include "algebra/expr.hpp"
 
@@ -52,6 +54,86 @@ Value mul_datum(ExprId id, DatumMemo &memo) {
   return list({op_symbol(Op::Div), product_datum(num), product_datum(den)});
 }
 
+// A monomial as scmutils' printer sees it: an optional number and factors
+// (base, positive exponent) in order. Anything that is not a product of
+// powers (a sum, a quotient) is not one; other kernels are bases.
+struct Monomial {
+  ExprId coefficient = kNoExpr;
+  std::vector<std::pair<ExprId, int64_t>> factors;
+};
+
+bool add_factor(ExprId f, Monomial &m) {
+  int64_t e;
+  if (expr_is_apply(f, Op::Add) || expr_is_apply(f, Op::Div) || expr_is_apply(f, Op::Mul))
+    return false;
+  if (expr_is_apply(f, Op::Expt) && expr_get_int64(expr_arg(f, 1), &e)) {
+    if (e <= 0) return false;
+    m.factors.push_back({expr_arg(f, 0), e});
+  } else {
+    m.factors.push_back({f, 1});
+  }
+  return true;
+}
+
+bool as_monomial(ExprId id, Monomial &m) {
+  if (expr_is_number(id)) {
+    m.coefficient = id;
+    return true;
+  }
+  if (!expr_is_apply(id, Op::Mul)) return add_factor(id, m);
+  std::vector<ExprId> args = expr_arg_vector(id);
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (i == 0 && expr_is_number(args[i])) {
+      m.coefficient = args[i];
+      continue;
+    }
+    if (!add_factor(args[i], m)) return false;
+  }
+  return true;
+}
+
+// term / den with their common powers cancelled, as a datum: the term
+// itself when den cancels entirely.
+Value term_over(const Monomial &term, Monomial den, DatumMemo &memo) {
+  gcvec<Value> num, below;
+  if (term.coefficient != kNoExpr) num.push_back(to_datum(term.coefficient, memo));
+  for (auto [base, e] : term.factors) {
+    for (auto &[dbase, d] : den.factors)
+      if (dbase == base) {
+        int64_t common = std::min(e, d);
+        e -= common;
+        d -= common;
+      }
+    if (e > 0) num.push_back(power_datum(base, Value::fixnum(e), memo));
+  }
+  for (auto [dbase, d] : den.factors)
+    if (d > 0) below.push_back(power_datum(dbase, Value::fixnum(d), memo));
+  Value top = product_datum(num);
+  if (below.empty()) return top;
+  return list({op_symbol(Op::Div), top, product_datum(below)});
+}
+
+// scmutils writes a sum over a monomial denominator as the sum of its
+// terms, each over what is left of the denominator:
+// (+ ((D x) t) (/ (* -1 (p_x t)) m)), not (/ (+ (* m ((D x) t)) (* -1 (p_x t))) m).
+bool split_quotient(ExprId id, DatumMemo &memo, Value *out) {
+  ExprId n = expr_arg(id, 0), d = expr_arg(id, 1);
+  Monomial den;
+  if (!expr_is_apply(n, Op::Add) || !as_monomial(d, den) || den.coefficient != kNoExpr ||
+      den.factors.empty())
+    return false;
+  std::vector<Monomial> terms;
+  for (ExprId t : expr_arg_vector(n)) {
+    terms.emplace_back();
+    if (!as_monomial(t, terms.back())) return false;
+  }
+  gcvec<Value> items;
+  for (const Monomial &t : terms)
+    items.push_back(term_over(t, den, memo));
+  *out = list_of(op_symbol(Op::Add), items);
+  return true;
+}
+
 Value compute_datum(ExprId id, DatumMemo &memo) {
   const ExprNode &n = expr_node(id);
   switch (n.kind) {
@@ -69,6 +151,7 @@ Value compute_datum(ExprId id, DatumMemo &memo) {
   }
   Op op = n.op;
   if (op == Op::Mul) return mul_datum(id, memo);
+  if (Value split; op == Op::Div && split_quotient(id, memo, &split)) return split;
   int64_t e;
   if (op == Op::Expt && expr_get_int64(expr_arg(id, 1), &e) && e < 0)
     return list({op_symbol(Op::Div), Value::fixnum(1),

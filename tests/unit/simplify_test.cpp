@@ -93,7 +93,9 @@ TEST(Simplify, RationalFunctions) {
   EXPECT_EQ(pe(div({x, sub({mul({N(2), S("b")}), mul({N(4), S("a")})})})),
             "(/ (* -1 x) (+ (* 4 a) (* -2 b)))");
   EXPECT_EQ(pe(div({N(1), add({S("a"), S("b")})})), "(/ 1 (+ a b))");
-  EXPECT_EQ(pe(add({div({N(1), x}), div({N(1), S("y")})})), "(/ (+ x y) (* x y))");
+  // Over a monomial denominator each term is written over what is left of
+  // it, as scmutils writes the book's Hamiltonians (prefix_form.cpp).
+  EXPECT_EQ(pe(add({div({N(1), x}), div({N(1), S("y")})})), "(+ (/ 1 y) (/ 1 x))");
 }
 
 TEST(Simplify, ScmutilsTermAndFactorOrder) {
