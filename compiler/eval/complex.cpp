@@ -201,7 +201,10 @@ Value complex_expt(Value b, Value e) {
     }
     return negative ? num_div(exact_int(1), result) : result;
   }
-  if (num_is_zero(b)) return num_expt(b, e); // 0^e: exact-zero and division rules
+  if (num_is_zero(b)) { // MIT: 0 for an exponent with a positive real part, else an error
+    if (num_sign(re_of(e)) > 0) return is_exact(b) ? exact_int(0) : Value::flonum(0);
+    divide_by_zero("expt");
+  }
   return num_exp(num_mul(e, num_log(b)));
 }
 

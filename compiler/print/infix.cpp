@@ -23,10 +23,10 @@ bool is_natural(Value d) {
 }
 
 bool is_negative_term(Value d) {
-  if (is_number(d)) return num_sign(d) < 0;
+  if (is_number(d)) return is_real(d) && num_sign(d) < 0;
   if (!is_pair(d) || list_length(d) < 2) return false;
   Value first = car(cdr(d));
-  if (head_is(d, "*")) return is_number(first) && num_sign(first) < 0;
+  if (head_is(d, "*")) return is_real(first) && num_sign(first) < 0;
   if (head_is(d, "-")) return list_length(d) == 2;
   if (head_is(d, "/")) return is_negative_term(first);
   return false;
@@ -84,9 +84,11 @@ std::string wrap(const Text &t, int min, bool paren_neg = false) {
 }
 
 Text number_text(Value d) {
-  Text t{number_to_string(d), kAtom, num_sign(d) < 0};
-  // 1/2 reads as a quotient, so (1/2)^2; a negative number as a negation.
+  Text t{number_to_string(d), kAtom, is_real(d) && num_sign(d) < 0};
+  // 1/2 reads as a quotient, so (1/2)^2; a negative number as a negation;
+  // a complex number 1+2i as a sum.
   if (t.neg || d.is(Tag::Ratnum)) t.prec = kProduct;
+  if (is_recnum(d)) t.prec = kSum;
   return t;
 }
 

@@ -37,7 +37,7 @@ std::string wrap(const Text &t, int min, bool paren_neg = false) {
 
 // 1/2 as \frac{1}{2}; 1e-20 as 1 \times 10^{-20}; otherwise Scheme's text.
 Text number_text(Value d) {
-  bool neg = num_sign(d) < 0;
+  bool neg = is_real(d) && num_sign(d) < 0;
   Text t{"", kAtom, neg};
   if (d.is(Tag::Ratnum)) {
     Value a = num_abs(d);
@@ -52,6 +52,7 @@ Text number_text(Value d) {
     }
   }
   if (neg) t.prec = kProduct;
+  if (is_recnum(d)) t.prec = kSum; // 1+2i reads as a sum
   return t;
 }
 
