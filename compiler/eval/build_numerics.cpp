@@ -17,6 +17,7 @@
 #include "codegen/state_shape.hpp"
 #include "codegen/trace.hpp"
 #include "eval/build_state.hpp"
+#include "eval/limits.hpp"
 #include "eval/number.hpp"
 #include "eval/numerics_defaults.hpp"
 #include "eval/primitive.hpp"
@@ -271,44 +272,51 @@ Value bisect_at_run_time(Value *a, int n) {
   return r;
 }
 
+// A numerical primitive whose result cannot be left for run time, computed
+// while compiling by the interpreter's `name`, as sicm run computes it: the
+// program keeps the number, and an error of the program is raised as sicm
+// run raises it. Where the function reads values known only at run time it
+// cannot be computed now either; what the program added is rewound and
+// `why_not` says so.
+Value computed_while_compiling(const char *name, Value *a, int n,
+                               const std::function<void()> &why_not) {
+  ProgramMark mark = mark_program();
+  try {
+    return call_original(name, a, n);
+  } catch (const Error &e) {
+    if (!is_cannot_compile(e)) throw;
+    rewind_program(mark);
+  }
+  why_not();
+  SICM_ASSERT(false); // why_not throws
+  return Value::unspecified();
+}
+
 // bisect with a function that cannot be compiled (it builds streams, or
 // lists that it mutates, as the book's which-way? of section 4.6.1 does) but
-// with every number known now: the interpreter's bisect computes the root
-// while compiling, as sicm run computes it, and the program keeps the number.
-// A function that reads run-time values cannot be evaluated now either, and
-// the error is the compiler's.
+// with every number known now is computed while compiling.
 Value P_bisect(Value *a, int n) {
   bool known = is_number(a[1]) && is_number(a[2]) && is_number(a[3]) &&
                (n < 5 || a[4].is(Tag::Default) || is_number(a[4]));
   ProgramMark mark = mark_program();
+  const SrcLoc call = current_call_loc(); // the trace moves it into the function
   try {
     return bisect_at_run_time(a, n);
   } catch (const Error &e) {
     if (!known || !is_cannot_compile(e)) throw;
     rewind_program(mark);
+    reset_call_loc(call);
     Error why = e;
-    try {
-      return call_original("bisect", a, n);
-    } catch (const Error &) {
-      throw why;
-    }
+    return computed_while_compiling("bisect", a, n, [&] { throw why; });
   }
 }
 
-// nelder-mead is not compiled for run time. With every number it needs
-// known now, the interpreter's nelder-mead computes the minimum while
-// compiling, as sicm run computes it (an error of the program is raised as
-// sicm run raises it); a function that reads run-time values cannot be.
+// nelder-mead is not compiled for run time: it is computed while compiling.
 Value P_nelder_mead(Value *a, int n) {
-  ProgramMark mark = mark_program();
-  try {
-    return call_original("nelder-mead", a, n);
-  } catch (const Error &e) {
-    if (!is_cannot_compile(e)) throw;
-    rewind_program(mark);
+  return computed_while_compiling("nelder-mead", a, n, [] {
     cannot_compile(here(), "nelder-mead is not compiled for run time, and its function reads "
                            "values known only at run time");
-  }
+  });
 }
 
 // The integrator of argument i (or *ode-integration-method*) as the

@@ -7,8 +7,8 @@
 // exactness follows from the parts: (* 2 1+i) is 2+2i, (sqrt -4) is +2i,
 // (log -1) is +3.141592653589793i with an exact-zero real part. The
 // elementary functions use the textbook identities MIT uses (exp through
-// make-polar, log through magnitude and angle, sin and cos through sinh and
-// cosh, the inverse functions through log and sqrt), so exact zeros survive
+// make-polar, log through magnitude and angle, sin and cos through e^(iz)
+// and e^(-iz), the inverse functions through log and sqrt), so exact zeros survive
 // where MIT's do and inexact results agree with MIT's to the last bit or two.
 #include <cmath>
 #include <numbers>
