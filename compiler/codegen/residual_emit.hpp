@@ -15,6 +15,15 @@ namespace sicm {
 // on a symbol or an unknown function.
 std::string emit_residual_program(const ResidualProgram &program);
 
+// Function `function` of the program (which calls no other and captures
+// nothing) as a C11 unit for sicm run to load: it needs no runtime, and
+// defines int ENTRY(const double *in, double *out), which computes the
+// function and returns 0, or returns 1 where one of the program's checked
+// operations (a division by zero, a square root of a negative number) would
+// fail, leaving the value to the interpreter. See eval/build_for_run.cpp.
+std::string emit_residual_function(const ResidualProgram &program, int function,
+                                   const std::string &entry);
+
 // s as a C string literal (with the quotes) in which every byte that is not
 // printable ASCII, and " \ ?, is escaped.
 std::string c_string_literal(std::string_view s);

@@ -40,6 +40,19 @@ bool block_calls(const std::vector<RStmt> &block) {
 namespace {
 
 long g_branch_evaluations = 0; // alternatives evaluated under tests on run-time values
+// g_open.size() when each with-output-to-string began, innermost last.
+std::vector<size_t> g_capture_depths;
+
+} // namespace
+
+void reset_branches() {
+  g_capture_depths.clear();
+  g_undo.clear();
+  g_undo_serials.clear();
+  g_branch_evaluations = 0;
+}
+
+namespace {
 
 // The value that is `a` when test holds at run time and `b` otherwise.
 Value select_values(Value test, Value a, Value b) {
@@ -263,9 +276,98 @@ Value hook_set_global(Symbol *s, Value v, SrcLoc loc) {
 Value hook_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc) {
   // Frames made before the innermost traced procedure began belong to its
   // callers: state kept across run-time calls.
-  bool outer = g_open.size() > 1 && f->serial <= g_function_serials.back();
+  bool outer = g_open.size() > 1 && !made_since(f->serial, g_function_serials.back());
   bool may_create = g_open.size() == 2;
   return assign(&f->slots[index], "a local variable", v, loc, outer, may_create, f);
+}
+
+// ---- mutation of objects made before a traced procedure was called ----------------------
+//
+// A procedure traced for run time runs once, at compile time: a pair,
+// vector or string it did not make would be changed once instead of at
+// each call (and might keep a run-time value), and a promise made outside
+// it would be forced during the trace, its effects traced into the
+// procedure. Both are refused; what the procedure makes for itself it may
+// change as it likes.
+
+namespace {
+
+[[noreturn]] void refuse_outer(const char *who, const char *what) {
+  cannot_compile(here(), std::string(who) + " of " + what +
+                             " made outside the procedure traced for run time (the procedure "
+                             "runs once, while compiling)");
+}
+
+// Refuse who's mutation of v if v (a pair of the list it starts, a vector,
+// a string) was made before the innermost traced procedure was called.
+void check_owned(Value v, const char *who) {
+  if (g_open.size() <= 1) return;
+  uint32_t start = g_function_serials.back();
+  if (v.is(Tag::Vector) && !made_since(v.vector()->serial, start)) refuse_outer(who, "a vector");
+  if (v.is(Tag::String)) refuse_outer(who, "a string");
+  for (long n = 0; is_pair(v) && n < 1000000; v = cdr(v), ++n)
+    if (!made_since(v.pair()->serial, start)) refuse_outer(who, "a pair");
+}
+
+template <const char *Name, int Arg, bool AllButLast> Value P_owned(Value *a, int n) {
+  if (AllButLast) {
+    for (int i = 0; i + 1 < n; ++i)
+      check_owned(a[i], Name);
+  } else if (Arg < n) {
+    check_owned(a[Arg], Name);
+  }
+  return call_original(Name, a, n);
+}
+constexpr char kSetCar[] = "set-car!";
+constexpr char kSetCdr[] = "set-cdr!";
+constexpr char kVectorSet[] = "vector-set!";
+constexpr char kVectorFill[] = "vector-fill!";
+constexpr char kVectorCopy[] = "vector-copy!";
+constexpr char kAppendBang[] = "append!";
+constexpr char kStringSet[] = "string-set!";
+
+} // namespace
+
+namespace {
+
+Value P_with_output_to_string(Value *a, int n) {
+  g_capture_depths.push_back(g_open.size());
+  try {
+    Value v = call_original("with-output-to-string", a, n);
+    g_capture_depths.pop_back();
+    return v;
+  } catch (...) {
+    g_capture_depths.pop_back();
+    throw;
+  }
+}
+
+} // namespace
+
+// Output of a traced procedure into a string that a with-output-to-string
+// outside it captures: the text would be captured once, while compiling.
+void hook_capture() {
+  if (!g_capture_depths.empty() && g_open.size() > g_capture_depths.back())
+    cannot_compile(here(), "output of a procedure traced for run time into the string of a "
+                           "with-output-to-string outside it");
+}
+
+void hook_forcing(Value promise) {
+  if (g_open.size() <= 1) return;
+  Frame *env = promise.as<Promise>()->env;
+  if (!env || !made_since(env->serial, g_function_serials.back()))
+    refuse_outer("forcing", "a promise");
+}
+
+void rebind_mutators() {
+  rebind(kSetCar, 2, 2, P_owned<kSetCar, 0, false>);
+  rebind(kSetCdr, 2, 2, P_owned<kSetCdr, 0, false>);
+  rebind(kVectorSet, 3, 3, P_owned<kVectorSet, 0, false>);
+  rebind(kVectorFill, 2, kVariadic, P_owned<kVectorFill, 0, false>);
+  rebind(kVectorCopy, 3, 5, P_owned<kVectorCopy, 0, false>);
+  rebind(kAppendBang, 0, kVariadic, P_owned<kAppendBang, 0, true>);
+  rebind(kStringSet, 3, 3, P_owned<kStringSet, 0, false>);
+  rebind("with-output-to-string", 0, 1, P_with_output_to_string);
 }
 
 } // namespace sicm::build

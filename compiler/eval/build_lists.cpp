@@ -52,6 +52,13 @@ std::vector<ListCell> g_list_cells;
 gcvec<Value> g_list_shapes;                   // per list: its elements' shape
 std::vector<std::vector<RType>> g_list_types; // per list: its elements' leaves' kinds
 
+void reset_lists() {
+  g_list_cell_elements.clear();
+  g_list_cells.clear();
+  g_list_shapes.clear();
+  g_list_types.clear();
+}
+
 int list_cell_of(const Value *place) {
   for (size_t i = 0; i < g_list_cells.size(); ++i)
     if (g_list_cells[i].place == place) return static_cast<int>(i);

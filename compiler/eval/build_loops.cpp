@@ -693,6 +693,16 @@ struct UnrollLimit { // thrown to the watched call of `closure`
 std::vector<StaticWatch *> g_watches;
 std::unordered_set<Lambda *> g_unrolled_lambdas; // whose loops could not be left for run time
 
+} // namespace
+
+void reset_loops() {
+  g_loops.clear();
+  g_watches.clear();
+  g_unrolled_lambdas.clear();
+}
+
+namespace {
+
 // A call of c with known arguments: if c is watched, count it (and throw
 // UnrollLimit past the limit) and say so.
 bool count_known_call(Closure *c) {

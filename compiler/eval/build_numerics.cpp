@@ -122,7 +122,8 @@ void set_outputs(Value result, const char *who) {
     current().outputs.push_back(expr_of(leaf, who));
 }
 
-// Trace a scalar function (integrand, objective, function with a root).
+} // namespace
+
 int trace_scalar(Value f, const char *who) {
   if (!is_procedure(f)) wrong_type(f, 1, who);
   FunctionScope scope(procedure_name(f));
@@ -134,6 +135,8 @@ int trace_scalar(Value f, const char *who) {
   set_outputs(r, who);
   return scope.id();
 }
+
+namespace {
 
 // ---- numerical primitives ---------------------------------------------------------------
 

@@ -132,6 +132,11 @@ void rebind_plot_primitives();      // build_plots.cpp
 void rebind_list_primitives();      // build_lists.cpp
 void rebind_parallel_primitives();  // build_parallel.cpp
 
+// Empty the state of each part, for end_build_mode.
+void reset_branches(); // build_branches.cpp
+void reset_lists();    // build_lists.cpp
+void reset_loops();    // build_loops.cpp
+
 // ---- branches on run-time values (build_branches.cpp) -------------------------------------
 
 // Globals assigned while an alternative is evaluated: their values before
@@ -158,6 +163,10 @@ Value hook_branch(Value test, Node *then, Node *else_, Frame *env);
 Value hook_logic(Value test, Node *n, uint32_t from, bool is_and, Frame *env);
 Value hook_set_global(Symbol *s, Value v, SrcLoc loc);
 Value hook_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc);
+void hook_forcing(Value promise);
+void hook_capture();
+// set-car!, vector-set!, ... refuse objects made outside the traced procedure.
+void rebind_mutators();
 
 // ---- procedures traced into functions (build_numerics.cpp) ----------------------------
 
@@ -166,6 +175,9 @@ Value hook_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc);
 // function's body, and the cells and list variables are as the caller sees
 // them again afterwards. Returns the function's id.
 int in_new_function(const std::string &name, const std::function<void()> &body);
+// Trace a scalar function (integrand, objective, function with a root) into
+// a new function of one input and one output; returns its id.
+int trace_scalar(Value f, const char *who);
 // A value shaped like `sample` (a number, or an up/down structure of them)
 // whose leaves are fresh inputs of the open function.
 Value input_like(Value sample);

@@ -654,9 +654,9 @@ template <const char *Name> Value P_identity_on_dynamic(Value *a, int n) {
 constexpr char kExactToInexact[] = "exact->inexact";
 constexpr char kInexact[] = "inexact";
 
-const DynamicBranchHooks kHooks = {hook_dynamic_test,  hook_branch,    hook_logic,
-                                   hook_set_global,    hook_set_local, hook_call_closure,
-                                   hook_apply_to_other};
+const DynamicBranchHooks kHooks = {hook_dynamic_test,   hook_branch,    hook_logic,
+                                   hook_set_global,     hook_set_local, hook_call_closure,
+                                   hook_apply_to_other, hook_forcing};
 
 Value prepare_toplevel(Value v) {
   return prepare_for_print(v);
@@ -668,15 +668,31 @@ Value call_original(const char *name, Value *a, int n) {
   return original(name)(a, n);
 }
 
+namespace {
+
+// What each rebound name held before (a primitive, or unbound), for end_build_mode.
+std::vector<Symbol *> g_rebound;
+gcvec<Value> g_rebound_values; // scanned: the primitives' objects stay alive
+std::vector<bool> g_rebound_bound;
+
+} // namespace
+
 void rebind(const char *name, int min, int max, PrimFn fn) {
   Symbol *s = intern(name).symbol();
   if (s->bound && s->global.is(Tag::Primitive)) g_original[name] = s->global.as<Primitive>()->fn;
+  g_rebound.push_back(s);
+  g_rebound_values.push_back(s->global);
+  g_rebound_bound.push_back(s->bound);
   define_primitive(name, min, max, fn);
 }
 
 } // namespace sicm::build
 
 namespace sicm {
+
+bool in_build_mode() {
+  return build::g_prog != nullptr;
+}
 
 void begin_build_mode(ResidualProgram *program) {
   using namespace build;
@@ -737,10 +753,41 @@ void begin_build_mode(ResidualProgram *program) {
 
   rebind_list_primitives();
   rebind_parallel_primitives();
+  rebind_mutators();
 
   set_output_hook(residual_output);
+  set_capture_hook(hook_capture);
   set_print_preparer(prepare_toplevel);
   g_dynamic_branch_hooks = &kHooks;
+}
+
+void end_build_mode() {
+  using namespace build;
+  for (size_t i = g_rebound.size(); i-- > 0;) { // the first rebinding of a name holds the original
+    g_rebound[i]->global = g_rebound_values[i];
+    g_rebound[i]->bound = g_rebound_bound[i];
+  }
+  g_rebound.clear();
+  g_rebound_values.clear();
+  g_rebound_bound.clear();
+  g_original.clear();
+  g_dynamic_branch_hooks = nullptr;
+  set_output_hook(nullptr);
+  set_capture_hook(nullptr);
+  set_print_preparer(nullptr);
+  set_run_time_value_test(nullptr);
+  g_prog = nullptr;
+  g_open.clear();
+  g_var_of.clear();
+  g_branch_depth = 0;
+  g_blocks.clear();
+  g_work = 0;
+  g_cell_initialized.clear();
+  g_cell_frames.clear();
+  g_function_serials.clear();
+  reset_branches();
+  reset_lists();
+  reset_loops();
 }
 
 } // namespace sicm

@@ -163,7 +163,8 @@ bool equal(Value a, Value b) {
 namespace {
 std::string *g_capture = nullptr; // with-output-to-string redirects here
 int g_column = 0;
-OutputHook g_output_hook = nullptr; // sicm build: output becomes residual statements
+OutputHook g_output_hook = nullptr;   // sicm build: output becomes residual statements
+CaptureHook g_capture_hook = nullptr; // sicm build: may refuse output into a string
 } // namespace
 
 namespace {
@@ -181,9 +182,14 @@ void set_output_hook(OutputHook hook) {
   g_output_hook = hook;
 }
 
+void set_capture_hook(CaptureHook hook) {
+  g_capture_hook = hook;
+}
+
 void output(std::string_view s) {
   if (s.empty()) return;
   if (g_capture) {
+    if (g_capture_hook) g_capture_hook();
     g_capture->append(s);
   } else if (g_output_hook) {
     g_output_hook(s);

@@ -12,7 +12,9 @@
 // a native kernel (compile-procedure, codegen/kernel.hpp) of the right
 // shape, the same callbacks run the kernel on the doubles directly, without
 // making Scheme values; a pass that compiles system derivatives and
-// integrands automatically only has to hand a kernel in.
+// integrands automatically only has to hand a kernel in. bisect's function,
+// when one interpreted call proves expensive, is compiled by sicm build's
+// partial evaluator (eval/build_for_run.cpp), loops and tests included.
 //
 // Errors. A Scheme error (or a continuation escape) inside a callback must
 // not unwind through the runtime's C frames: the callback catches it, tells
@@ -44,6 +46,8 @@
 #include "algebra/structure.hpp"
 #include "bench/integration_sites.hpp"
 #include "codegen/kernel.hpp"
+#include "eval/build.hpp"
+#include "eval/limits.hpp"
 #include "eval/number.hpp"
 #include "eval/numerics_defaults.hpp"
 #include "eval/primitive.hpp"
@@ -161,7 +165,11 @@ struct Callback {
 // to find a root of).
 struct ScalarCallback : Callback {
   Value f;
-  const Kernel *kernel;   // f itself when it is a kernel of one real
+  const Kernel *kernel; // f itself when it is a kernel of one real
+  // compile_expensive: f compiled by the partial evaluator once one
+  // interpreted call has taken kCompileAfterSteps steps (compiled: the result).
+  bool compile_expensive = false, compile_tried = false;
+  CompiledScalarFn compiled = nullptr;
   bool nonfinite = false; // f returned a NaN or an infinity, first at bad_x
   double bad_x = 0, bad_value = 0;
   ScalarCallback(SrcLoc l, const char *w, Value fn)
@@ -188,6 +196,16 @@ double real_result(const Callback &cb, Value r, const std::string &at) {
   return to_double(r);
 }
 
+// An interpreted call of bisect's function that takes more evaluator steps
+// than this (some milliseconds) makes it worth compiling: the book's
+// which-way? iterates a map thousands of times per call, and bisect calls
+// it some fifty times; a cheap function is not worth the C compiler's
+// tenth of a second.
+constexpr uint64_t kCompileAfterSteps = 50000;
+
+// Compile cb's procedure by the partial evaluator (compile_for_run), once.
+void compile_expensive(ScalarCallback &cb);
+
 double call_scalar(double x, void *data) {
   auto *cb = static_cast<ScalarCallback *>(data);
   if (cb->error) return NAN;
@@ -195,10 +213,13 @@ double call_scalar(double x, void *data) {
     double v;
     if (cb->kernel) {
       kernel_call(cb->kernel, &x, &v);
-    } else {
+    } else if (!cb->compiled || cb->compiled(&x, &v) != 0) {
+      uint64_t steps = steps_taken();
       Value arg = Value::flonum(x);
       Value r = apply_procedure(cb->f, &arg, 1);
       v = real_result(*cb, r, number_text(x));
+      if (cb->compile_expensive && !cb->compile_tried && steps_taken() - steps > kCompileAfterSteps)
+        compile_expensive(*cb);
     }
     if (!std::isfinite(v) && !cb->nonfinite) {
       cb->nonfinite = true;
@@ -570,6 +591,14 @@ bool kernels_enabled() {
     return !(e && *e && std::strcmp(e, "0") != 0);
   }();
   return enabled;
+}
+
+void compile_expensive(ScalarCallback &cb) {
+  cb.compile_tried = true;
+  if (!kernels_enabled() || g_auto_kernels >= kMaxAutoKernels) return;
+  std::string why_not;
+  cb.compiled = compile_for_run(cb.f, cb.who, &why_not);
+  if (cb.compiled) ++g_auto_kernels;
 }
 
 // With taylor, the kernel also has the Taylor coefficients of the solution
@@ -1058,6 +1087,7 @@ Value P_bisect(Value *a, int n) {
   if (!(eps >= 0)) bad_range(a[3], 4, who);
   long n_break = is_missing(a, n, 4) ? kBisectBreak : static_cast<long>(arg_index(a, 4, who));
   ScalarCallback cb(loc, who, f);
+  cb.compile_expensive = true;
   double root = 0, bracket[2], values[2];
   int status = sicm_root_bisect(call_scalar, &cb, x0, x1, eps, n_break, kBisectMaxIter, &root,
                                 bracket, values);

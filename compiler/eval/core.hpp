@@ -19,6 +19,10 @@ void output(std::string_view s);
 // the hook instead of stdout (null: stdout).
 using OutputHook = void (*)(std::string_view s);
 void set_output_hook(OutputHook hook);
+// sicm build: called before output goes into with-output-to-string's string
+// (null: nothing); may throw.
+using CaptureHook = void (*)();
+void set_capture_hook(CaptureHook hook);
 // sicm build: run_source passes each top-level value it prints through this
 // first (null: none), so run-time values can be named in the output.
 using PrintPreparer = Value (*)(Value v);

@@ -435,6 +435,8 @@ Value force_promise(Value v) {
   if (!v.is(Tag::Promise)) return v;
   Promise *p = v.as<Promise>();
   if (!p->forced) {
+    if (g_dynamic_branch_hooks && g_dynamic_branch_hooks->forcing)
+      g_dynamic_branch_hooks->forcing(v);
     Value r = eval(p->expr, p->env);
     if (!p->forced) { // not forced re-entrantly meanwhile
       p->forced = true;

@@ -113,10 +113,10 @@ struct DynamicBranchHooks {
   // time (args: all of them): true and the result in *out if the hook
   // evaluated it, false for the usual error.
   bool (*apply_to_other)(Value f, Value *args, long nargs, Value *out);
+  // Before a promise not yet forced is forced (null: nothing to do); may throw.
+  void (*forcing)(Value promise) = nullptr;
 };
 extern const DynamicBranchHooks *g_dynamic_branch_hooks;
-// Frames made so far (each frame records it as its serial).
-extern uint32_t g_frame_serial;
 
 // The and/or node n evaluated from argument `from` on (not a tail call).
 Value eval_logic_from(Node *n, uint32_t from, Frame *env);

@@ -170,10 +170,23 @@ inline char *gc_strdup(std::string_view s) {
   return mem;
 }
 
+// The heap's clock: frames made so far. Frames, pairs and vectors record it
+// when made (their serial), so sicm build can tell what a procedure made
+// from what existed before it was called. It wraps; compare with made_since.
+extern uint32_t g_frame_serial;
+
+// Was an object of this serial made after the clock read `start`? (Modulo
+// 2^32: right unless 2^32 frames have been made since.)
+inline bool made_since(uint32_t serial, uint32_t start) {
+  return serial - start - 1 < g_frame_serial - start;
+}
+
 struct Pair {
   Value car, cdr;
   SrcLoc loc; // where the reader saw this pair's car (unknown for built pairs)
+  uint32_t serial = g_frame_serial; // in the padding: no larger
 };
+static_assert(sizeof(Pair) == 48, "a pair's serial must fit in its padding");
 
 struct Symbol {
   std::string name; // symbols are never collected, so std::string is fine
@@ -191,6 +204,7 @@ struct String {
 struct Vector {
   Value *items; // GC memory
   size_t len;
+  uint32_t serial = g_frame_serial;
 };
 
 struct Promise {

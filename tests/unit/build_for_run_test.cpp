@@ -1,0 +1,114 @@
+// Unit tests of compile_for_run (eval/build_for_run.cpp): a procedure of one
+// real compiled by the partial evaluator for sicm run, loops included, and
+// refused, with the heap as it was, when tracing it once would do its
+// effects once.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "eval/build.hpp"
+#include "eval/interp.hpp"
+#include "eval/number.hpp"
+#include "eval/procedure.hpp"
+#include "print/printer.hpp"
+#include "syntax/reader.hpp"
+
+using namespace sicm;
+
+namespace {
+
+// Evaluate every form of text; the value of the last.
+Value run(const std::string &text) {
+  Value v;
+  for (const ReadForm &f : read_all(register_source("<build_for_run_test>", text)))
+    v = eval_toplevel(f.datum, f.loc);
+  return v;
+}
+
+CompiledScalarFn compile(const std::string &proc, std::string *why) {
+  return compile_for_run(run(proc), "bisect", why);
+}
+
+double call(CompiledScalarFn fn, double x) {
+  double out = NAN;
+  EXPECT_EQ(fn(&x, &out), 0) << "at " << x;
+  return out;
+}
+
+TEST(CompileForRun, LoopWhoseExitDependsOnTheArgument) {
+  // Halve x until it is below 1: the count of halvings, minus 3.
+  std::string why;
+  CompiledScalarFn fn = compile("(lambda (x)"
+                                "  (let loop ((x x) (n 0))"
+                                "    (if (< x 1.) (- n 3) (loop (/ x 2.) (+ n 1)))))",
+                                &why);
+  ASSERT_NE(fn, nullptr) << why;
+  EXPECT_EQ(call(fn, 0.5), -3.0);
+  EXPECT_EQ(call(fn, 5.0), 0.0);    // 5 -> 2.5 -> 1.25 -> 0.625
+  EXPECT_EQ(call(fn, 1000.0), 7.0); // 2^10 = 1024
+}
+
+TEST(CompileForRun, ClosureOverKnownValues) {
+  run("(define (make-shifted c) (lambda (x) (- (* x x) c)))");
+  std::string why;
+  CompiledScalarFn fn = compile("(make-shifted 2)", &why);
+  ASSERT_NE(fn, nullptr) << why;
+  EXPECT_EQ(call(fn, 3.0), 7.0);
+}
+
+TEST(CompileForRun, CheckedOperationLeavesTheValueToTheInterpreter) {
+  std::string why;
+  CompiledScalarFn fn = compile("(lambda (x) (/ 1. (- x 2.)))", &why);
+  ASSERT_NE(fn, nullptr) << why;
+  double x = 2.0, out = 0;
+  EXPECT_EQ(fn(&x, &out), 1); // division by zero: the interpreter raises it
+  x = 3.0;
+  EXPECT_EQ(fn(&x, &out), 0);
+  EXPECT_EQ(out, 1.0);
+  fn = compile("(lambda (x) (sqrt x))", &why);
+  ASSERT_NE(fn, nullptr) << why;
+  x = -1.0;
+  EXPECT_EQ(fn(&x, &out), 1); // a complex number
+}
+
+TEST(CompileForRun, AssignmentOfAnOuterVariableIsRefusedAndNotDone) {
+  run("(define calls 0)");
+  std::string why;
+  EXPECT_EQ(compile("(lambda (x) (set! calls (+ calls 1)) x)", &why), nullptr);
+  EXPECT_NE(why.find("set!"), std::string::npos) << why;
+  EXPECT_EQ(write_string(run("calls")), "0");
+  run("(define (counter) (let ((n 0)) (lambda (x) (set! n (+ n 1)) (- x n))))");
+  EXPECT_EQ(compile("(counter)", &why), nullptr);
+}
+
+TEST(CompileForRun, MutationOutputAndPromisesAreRefusedAndNotDone) {
+  run("(define v (vector 0))");
+  std::string why;
+  EXPECT_EQ(compile("(lambda (x) (vector-set! v 0 x) x)", &why), nullptr);
+  EXPECT_EQ(write_string(run("v")), "#(0)");
+  run("(define p (delay (vector-set! v 0 1)))");
+  EXPECT_EQ(compile("(lambda (x) (force p) x)", &why), nullptr);
+  EXPECT_EQ(write_string(run("v")), "#(0)");
+  EXPECT_EQ(compile("(lambda (x) (display x) x)", &why), nullptr);
+  EXPECT_EQ(compile("(lambda (x) (+ x (random 1.)))", &why), nullptr);
+}
+
+TEST(CompileForRun, TheInterpreterIsItselfAfterwards) {
+  std::string why;
+  EXPECT_EQ(compile("(lambda (x) (display x) x)", &why), nullptr);
+  // The primitives the trace rebound are the interpreter's again.
+  EXPECT_EQ(write_string(run("(with-output-to-string (lambda () (display 1.5)))")), "\"1.5\"");
+  EXPECT_EQ(write_string(run("(< 1 2 3)")), "#t");
+  EXPECT_EQ(write_string(run("(let ((p (cons 1 2))) (set-car! p 3) p)")), "(3 . 2)");
+  EXPECT_FALSE(in_build_mode());
+}
+
+TEST(CompileForRun, NumericalPrimitivesInsideAreRefused) {
+  std::string why;
+  EXPECT_EQ(compile("(lambda (x) (- (definite-integral (lambda (t) (* t t)) 0. x) 1.))", &why),
+            nullptr);
+  EXPECT_FALSE(in_build_mode());
+}
+
+} // namespace
