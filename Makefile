@@ -58,7 +58,7 @@ COMPILER_OBJS := $(COMPILER_SRCS:%.cpp=$(BUILD)/%.o) $(BUILD)/gen/stdlib_embed.o
 RUNTIME_OBJS  := $(RUNTIME_SRCS:%.c=$(BUILD)/%.o) $(RUNTIME_CXX_SRCS:%.cpp=$(BUILD)/%.o)
 UNIT_OBJS     := $(UNIT_SRCS:%.cpp=$(BUILD)/%.o)
 # Everything of the compiler except its entry point, for the unit tests.
-LIB_OBJS      := $(filter-out $(BUILD)/compiler/main.o,$(COMPILER_OBJS))
+LIB_OBJS      := $(filter-out $(BUILD)/compiler/driver/main.o,$(COMPILER_OBJS))
 
 SICM    := $(BUILD)/sicm
 RTLIB   := $(BUILD)/libsicmrt.a

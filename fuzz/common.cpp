@@ -11,10 +11,10 @@
 #include <cstdlib>
 #include <unordered_set>
 
-#include "eval/limits.hpp"
-#include "eval/number.hpp"
+#include "base/limits.hpp"
+#include "base/number.hpp"
+#include "base/value.hpp"
 #include "eval/procedure.hpp"
-#include "eval/value.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 extern "C" int LLVMFuzzerRunDriver(int *argc, char ***argv,
@@ -23,7 +23,7 @@ extern "C" int LLVMFuzzerRunDriver(int *argc, char ***argv,
 namespace {
 
 // The stack reserved for evaluation, and the part kept free below the guard
-// for primitives. compiler/main.cpp reserves 256 MiB; here it is 60 MiB,
+// for primitives. compiler/driver/main.cpp reserves 256 MiB; here it is 60 MiB,
 // because AddressSanitizer declines to clear its records of a stack larger
 // than 64 MiB when an exception unwinds it, and then reports false
 // stack-buffer-overflows (google/sanitizers issue 189). So deep recursion

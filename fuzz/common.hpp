@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "algebra/expr.hpp"
+#include "cas/expr.hpp"
 
 // Called once, on the fuzzing thread, before any input.
 void fuzz_setup();
@@ -37,7 +37,7 @@ void reset_stack_limit();
 // `nodes`, no other limit; begin_input counts it from zero again, as the
 // REPL does for each form. The simplify and emit targets use it to refuse
 // expansions that would take FLINT minutes (the limit's own check of
-// expansions, eval/limits.hpp) well inside libFuzzer's -timeout.
+// expansions, base/limits.hpp) well inside libFuzzer's -timeout.
 void limit_expression_nodes(uint64_t nodes);
 void begin_input();
 

@@ -76,15 +76,15 @@
 #include <unordered_set>
 #include <vector>
 
-#include "algebra/expr.hpp"
-#include "algebra/simplify.hpp"
 #include "algebra/symbolic.hpp"
+#include "base/number.hpp"
+#include "cas/expr.hpp"
+#include "cas/simplify.hpp"
 #include "codegen/emit_c.hpp"
 #include "codegen/kernel.hpp"
 #include "codegen/local_rewrite.hpp"
 #include "codegen/trace.hpp"
 #include "common.hpp"
-#include "eval/number.hpp"
 
 extern char **environ;
 
@@ -298,19 +298,9 @@ std::string slurp(const std::string &path) {
 std::string compile(const std::string &c_path, const std::string &so_path,
                     int seconds = kCompileSeconds) {
   std::string log = c_path + ".log";
-  const char *argv[] = {"cc",
-                        "-std=c11",
-                        "-O2",
-                        "-Wall",
-                        "-Wextra",
-                        "-Werror",
-                        "-fPIC",
-                        "-shared",
-                        "-o",
-                        so_path.c_str(),
-                        c_path.c_str(),
-                        "-lm",
-                        nullptr};
+  const char *argv[] = {"cc",           "-std=c11", "-O2",     "-Wall", "-Wextra",
+                        "-Werror",      "-fPIC",    "-shared", "-o",    so_path.c_str(),
+                        c_path.c_str(), "-lm",      nullptr};
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, 2, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
@@ -445,8 +435,7 @@ void check_kernel(const Pending &k, KernelFn fn) {
       // rounded to the other side of the domain's edge) is no finding.
       // So is a NaN where an argument's interval reached past its domain's
       // edge (Approx::edge): the C rounded to the other side of it.
-      bool unknown =
-          std::isnan(got) && (bound.edge || kBoundFactor * bound.e >= std::fabs(want));
+      bool unknown = std::isnan(got) && (bound.edge || kBoundFactor * bound.e >= std::fabs(want));
       if (std::isfinite(want) &&
           (relative || both_tiny || unknown || diff <= kBoundFactor * bound.e)) {
         ++g_stats.compared;

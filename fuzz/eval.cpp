@@ -42,15 +42,15 @@
 #include <unordered_set>
 #include <vector>
 
+#include "base/error.hpp"
+#include "base/srcloc.hpp"
+#include "builtins/plot.hpp"
 #include "common.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
-#include "eval/plot.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
-#include "syntax/error.hpp"
 #include "syntax/reader.hpp"
-#include "syntax/srcloc.hpp"
 
 using namespace sicm;
 

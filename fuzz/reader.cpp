@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "base/srcloc.hpp"
+#include "base/value.hpp"
 #include "common.hpp"
-#include "eval/value.hpp"
 #include "print/printer.hpp"
 #include "syntax/reader.hpp"
-#include "syntax/srcloc.hpp"
 
 using namespace sicm;
 

@@ -7,7 +7,7 @@
 // e be the expression and s = simplify(e). Properties:
 //   1. simplify returns or raises a sicm::Error (division by an expression
 //      that simplifies to zero); it never crashes;
-//   2. s is canonical (expr_is_canonical, algebra/expr.hpp C1-C6);
+//   2. s is canonical (expr_is_canonical, cas/expr.hpp C1-C6);
 //   3. s is a fixed point: simplify(s) is s. The simplifier memoizes, and its
 //      memo maps every result to itself, so simplify(s) is answered from the
 //      memo; the check therefore renames x, y, z to x1, y1, z1 (an
@@ -48,11 +48,11 @@
 #include <unordered_set>
 #include <vector>
 
-#include "algebra/expr.hpp"
-#include "algebra/simplify.hpp"
 #include "algebra/symbolic.hpp"
+#include "base/number.hpp"
+#include "cas/expr.hpp"
+#include "cas/simplify.hpp"
 #include "common.hpp"
-#include "eval/number.hpp"
 #include "print/printer.hpp"
 
 using namespace sicm;
@@ -329,15 +329,14 @@ struct Stats {
 
 void print_stats() {
   const Stats &s = g_stats;
-  std::fprintf(
-      stderr,
-      "simplify stats: %lu inputs, %lu expressions built, %lu raised an error, %lu "
-      "forms with flonums (printing unchecked) and %lu with nested roots (idempotence and "
-      "printing unchecked); %lu points: %lu "
-      "not finite, %lu "
-      "ill-conditioned, %lu matched on another sqrt branch, %lu not judged\n",
-      s.inputs, s.built, s.raised, s.flonums, s.nested_roots, s.points, s.not_finite,
-      s.ill_conditioned, s.other_branch, s.unjudged);
+  std::fprintf(stderr,
+               "simplify stats: %lu inputs, %lu expressions built, %lu raised an error, %lu "
+               "forms with flonums (printing unchecked) and %lu with nested roots (idempotence and "
+               "printing unchecked); %lu points: %lu "
+               "not finite, %lu "
+               "ill-conditioned, %lu matched on another sqrt branch, %lu not judged\n",
+               s.inputs, s.built, s.raised, s.flonums, s.nested_roots, s.points, s.not_finite,
+               s.ill_conditioned, s.other_branch, s.unjudged);
 }
 
 // Property 5 at kPoints points; see the top of the file.

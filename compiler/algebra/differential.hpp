@@ -21,7 +21,7 @@
 #include <utility>
 #include <vector>
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 

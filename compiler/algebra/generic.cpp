@@ -6,8 +6,8 @@
 
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
+#include "base/error.hpp"
 #include "eval/primitive.hpp"
-#include "syntax/error.hpp"
 
 namespace sicm {
 

@@ -1,6 +1,6 @@
 // Generic arithmetic: + - * / sin ... over numbers, expressions, structures and functions.
 //
-// Numbers take a fast path straight into the numeric tower (eval/number.hpp).
+// Numbers take a fast path straight into the numeric tower (base/number.hpp).
 // Every other kind of value belongs to an *arithmetic type*: a row of a small
 // table giving a membership test, a rank and the handlers of the unary and
 // binary operations. An operation on a value of some type is handled by that
@@ -28,9 +28,9 @@
 
 #include <cstdint>
 
-#include "eval/number.hpp"
+#include "base/number.hpp"
+#include "base/value.hpp"
 #include "eval/procedure.hpp"
-#include "eval/value.hpp"
 
 namespace sicm {
 

@@ -8,7 +8,7 @@
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
-#include "eval/number.hpp"
+#include "base/number.hpp"
 #include "eval/primitive.hpp"
 
 namespace sicm {

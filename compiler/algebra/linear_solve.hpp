@@ -31,8 +31,8 @@
 #include <cstddef>
 #include <optional>
 
-#include "algebra/expr.hpp"
-#include "eval/value.hpp"
+#include "base/value.hpp"
+#include "cas/expr.hpp"
 
 namespace sicm {
 

@@ -19,7 +19,7 @@
 #include "algebra/operator.hpp"
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
-#include "eval/number.hpp"
+#include "base/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"

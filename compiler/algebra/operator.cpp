@@ -17,7 +17,7 @@
 #include "algebra/series.hpp"
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
-#include "eval/number.hpp"
+#include "base/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"

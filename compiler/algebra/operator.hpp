@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 

@@ -9,8 +9,8 @@
 
 #include "algebra/generic.hpp"
 #include "algebra/operator.hpp"
+#include "base/number.hpp"
 #include "eval/core.hpp"
-#include "eval/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"

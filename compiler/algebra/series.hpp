@@ -2,7 +2,7 @@
 // operator, whose application to a function is its Taylor (or Lie) series.
 #pragma once
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 

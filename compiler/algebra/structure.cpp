@@ -12,7 +12,7 @@
 #include "algebra/linear_solve.hpp"
 #include "algebra/series.hpp"
 #include "algebra/symbolic.hpp"
-#include "eval/number.hpp"
+#include "base/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"

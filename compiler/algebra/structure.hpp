@@ -16,7 +16,7 @@
 
 #include <cstddef>
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 

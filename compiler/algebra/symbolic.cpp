@@ -3,11 +3,11 @@
 
 #include <cmath>
 
-#include "algebra/expr.hpp"
-#include "algebra/simplify.hpp"
 #include "algebra/structure.hpp"
+#include "base/number.hpp"
+#include "cas/expr.hpp"
+#include "cas/simplify.hpp"
 #include "eval/core.hpp"
-#include "eval/number.hpp"
 #include "eval/primitive.hpp"
 #include "print/printer.hpp"
 #include "sicm/runtime.h"
@@ -18,7 +18,7 @@ namespace {
 
 constexpr OpInfo kOpInfo[] = {
 #define SICM_OP(name, scheme, arity, c) {scheme, arity, c},
-#include "algebra/ops.def"
+#include "cas/ops.def"
 #undef SICM_OP
 };
 

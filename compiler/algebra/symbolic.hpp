@@ -2,20 +2,20 @@
 // (algebra/): how Scheme values become symbolic expressions and back.
 //
 // A symbolic value is a Value with Tag::Expr whose payload is an ExprId into
-// the hash-consed expression DAG (algebra/expr.hpp). Quoted symbols used as
+// the hash-consed expression DAG (cas/expr.hpp). Quoted symbols used as
 // numbers ('m, 'theta) are literal real numbers: arithmetic on them builds
 // expressions.
 #pragma once
 
 #include <cstdint>
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 
 enum class Op : uint8_t {
 #define SICM_OP(name, scheme, arity, c) name,
-#include "algebra/ops.def"
+#include "cas/ops.def"
 #undef SICM_OP
 };
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "bench/integration_sites.hpp"
-#include "eval/numerics_defaults.hpp"
+#include "builtins/numerics_defaults.hpp"
 #include "sicm/runtime.h"
 
 namespace sicm {

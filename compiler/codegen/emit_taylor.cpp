@@ -50,10 +50,10 @@
 
 #include "algebra/linear_solve.hpp"
 #include "algebra/symbolic.hpp"
+#include "base/error.hpp"
+#include "base/number.hpp"
 #include "codegen/emit_c.hpp"
-#include "eval/number.hpp"
 #include "sicm/runtime.h"
-#include "syntax/error.hpp"
 
 namespace sicm {
 

@@ -6,7 +6,7 @@
 #include <unordered_map>
 
 #include "algebra/linear_solve.hpp"
-#include "eval/number.hpp"
+#include "base/number.hpp"
 
 namespace sicm {
 

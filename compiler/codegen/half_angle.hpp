@@ -18,7 +18,7 @@
 
 #include <vector>
 
-#include "algebra/expr.hpp"
+#include "cas/expr.hpp"
 
 namespace sicm {
 

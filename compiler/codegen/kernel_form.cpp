@@ -7,13 +7,13 @@
 #include <unordered_set>
 
 #include "algebra/symbolic.hpp"
+#include "base/error.hpp"
+#include "base/limits.hpp"
+#include "base/number.hpp"
+#include "cas/evaluation_form.hpp"
 #include "codegen/emit_c.hpp"
-#include "codegen/evaluation_form.hpp"
 #include "codegen/half_angle.hpp"
 #include "codegen/local_rewrite.hpp"
-#include "eval/limits.hpp"
-#include "eval/number.hpp"
-#include "syntax/error.hpp"
 
 namespace sicm {
 

@@ -20,7 +20,7 @@
 //   - if its outputs together have at most kMaxCanonicalizedNodes distinct
 //     nodes and divide by at most kMaxCanonicalizedDenominators distinct
 //     expressions, each output is also brought to the canonical form (then to the
-//     evaluation form of codegen/evaluation_form.hpp) within
+//     evaluation form of cas/evaluation_form.hpp) within
 //     kCanonicalizationBudget new nodes, and the kernel keeps it if its C
 //     is kCanonicalAdvantage times shorter than the traced form's. Small
 //     kernels (the book's pendulums) gain from it: terms cancel, shared
@@ -35,8 +35,8 @@
 #include <functional>
 #include <vector>
 
-#include "algebra/expr.hpp"
-#include "eval/value.hpp"
+#include "base/value.hpp"
+#include "cas/expr.hpp"
 
 namespace sicm {
 

@@ -5,7 +5,7 @@
 #include <set>
 #include <unordered_map>
 
-#include "algebra/expr.hpp"
+#include "cas/expr.hpp"
 
 namespace sicm {
 

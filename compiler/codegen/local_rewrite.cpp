@@ -16,7 +16,7 @@
 #include <unordered_set>
 
 #include "algebra/linear_solve.hpp"
-#include "eval/number.hpp"
+#include "base/number.hpp"
 
 namespace sicm {
 

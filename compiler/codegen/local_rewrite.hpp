@@ -25,7 +25,7 @@
 
 #include <vector>
 
-#include "algebra/expr.hpp"
+#include "cas/expr.hpp"
 
 namespace sicm {
 

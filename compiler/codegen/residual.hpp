@@ -19,7 +19,7 @@
 // that enclose it (an integrand inside an objective uses the objective's
 // argument): those are captured and passed in p[] (see sicm/program.h).
 //
-// Requires: the evaluator running with the hooks of builtins_build.cpp
+// Requires: the evaluator running with the hooks of pe/build_mode.cpp
 // installed. Produces: a ResidualProgram that residual_emit.cpp writes as C.
 #pragma once
 
@@ -27,9 +27,9 @@
 #include <string>
 #include <vector>
 
-#include "algebra/expr.hpp"
-#include "eval/value.hpp"
-#include "syntax/srcloc.hpp"
+#include "base/srcloc.hpp"
+#include "base/value.hpp"
+#include "cas/expr.hpp"
 
 namespace sicm {
 
@@ -145,7 +145,7 @@ struct RCell {
 // A list built at run time whose elements all have one shape: a C global
 // (listN, a sicm_list of `width` doubles per element; see sicm/program.h).
 // A list value at compile time is a range of positions in it (see
-// builtins_build.cpp).
+// pe/build_mode.cpp).
 struct RList {
   int width;
   std::string name; // for comments

@@ -24,9 +24,9 @@
 #include <unordered_set>
 
 #include "algebra/linear_solve.hpp"
+#include "base/error.hpp"
 #include "codegen/emit_c.hpp"
 #include "codegen/emit_taylor.hpp"
-#include "syntax/error.hpp"
 
 namespace sicm {
 
@@ -413,7 +413,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
 
   // The Taylor coefficient function of system derivative f (fN_taylor or
   // fN_taylor_extended), generated once; its captures are read from p[] as
-  // f reads them. builtins_build.cpp checked that it can be generated.
+  // f reads them. pe/build_mode.cpp checked that it can be generated.
   std::string taylor_function(int f, bool extended) {
     std::string name = "f" + std::to_string(f) + (extended ? "_taylor_extended" : "_taylor");
     if (!taylor_names_.insert(name).second) return name;

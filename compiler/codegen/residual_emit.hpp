@@ -20,7 +20,7 @@ std::string emit_residual_program(const ResidualProgram &program);
 // defines int ENTRY(const double *in, double *out), which computes the
 // function and returns 0, or returns 1 where one of the program's checked
 // operations (a division by zero, a square root of a negative number) would
-// fail, leaving the value to the interpreter. See eval/build_for_run.cpp.
+// fail, leaving the value to the interpreter. See pe/for_run.cpp.
 std::string emit_residual_function(const ResidualProgram &program, int function,
                                    const std::string &entry);
 

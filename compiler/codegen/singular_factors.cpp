@@ -9,7 +9,7 @@
 #include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
-#include "eval/limits.hpp"
+#include "base/limits.hpp"
 #include "print/printer.hpp"
 
 namespace sicm {

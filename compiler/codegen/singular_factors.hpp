@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "algebra/expr.hpp"
+#include "cas/expr.hpp"
 
 namespace sicm {
 

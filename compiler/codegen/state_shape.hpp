@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 

@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "algebra/expr.hpp"
+#include "base/value.hpp"
+#include "cas/expr.hpp"
 #include "codegen/kernel_form.hpp"
-#include "eval/value.hpp"
 
 namespace sicm {
 

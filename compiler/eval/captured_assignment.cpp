@@ -4,8 +4,8 @@
 // them reaches a frame of an enclosing procedure.
 #include "eval/captured_assignment.hpp"
 
+#include "base/error.hpp"
 #include "eval/procedure.hpp"
-#include "syntax/error.hpp"
 
 namespace sicm {
 

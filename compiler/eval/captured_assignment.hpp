@@ -3,8 +3,8 @@
 // not set! (or fluid-let) a variable bound outside itself.
 #pragma once
 
-#include "eval/value.hpp"
-#include "syntax/srcloc.hpp"
+#include "base/srcloc.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 
@@ -17,7 +17,7 @@ struct CapturedAssignment {
 // The first assignment, in the text of f (a closure), of a variable bound
 // outside f: a global, or a local of an enclosing procedure. Procedures f
 // calls are not looked into (their assignments of globals are found by `sicm
-// build` when it compiles the members; see eval/build_parallel.cpp).
+// build` when it compiles the members; see pe/parallel.cpp).
 CapturedAssignment find_captured_assignment(Value f);
 
 // Raise parallel-map's located run-time error if f assigns a variable it

@@ -3,7 +3,7 @@
 
 #include <string_view>
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 

@@ -9,12 +9,12 @@
 // exceeded" instead of a segfault; the recursion depth limit sets where the
 // guard stands.
 // Every iteration of the loop is one step for the step limit, whose counter
-// also notices Ctrl-C in the REPL (eval/limits.hpp).
+// also notices Ctrl-C in the REPL (base/limits.hpp).
 #include <string>
 
 #include "algebra/structure.hpp"
+#include "base/limits.hpp"
 #include "eval/core.hpp"
-#include "eval/limits.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "eval/value.hpp"
-#include "syntax/error.hpp"
+#include "base/error.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 

@@ -6,7 +6,7 @@
 // (depth, index) into a chain of Frames; globals live in their Symbol.
 #pragma once
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 
@@ -91,7 +91,7 @@ Node *analyze_toplevel(Value datum, SrcLoc loc);
 // Evaluate an analyzed node in an environment (null for top level).
 Value eval(Node *node, Frame *env);
 
-// Hooks for `sicm build` (eval/builtins_build.cpp), null otherwise. When a
+// Hooks for `sicm build` (pe/build_mode.cpp), null otherwise. When a
 // test of if, and, or evaluates to a value that `dynamic_test` accepts (a
 // truth value known only at run time), the evaluator does not choose a
 // branch: `branch` gets the test and both alternatives (else_ may be null)

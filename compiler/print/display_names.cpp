@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "syntax/utf8.hpp"
+#include "base/utf8.hpp"
 
 namespace sicm {
 

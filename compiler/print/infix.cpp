@@ -6,7 +6,7 @@
 // meaning or where a minus would sit right after another operator.
 #include "print/infix.hpp"
 
-#include "eval/number.hpp"
+#include "base/number.hpp"
 #include "print/display_names.hpp"
 #include "print/printer.hpp"
 

@@ -28,14 +28,14 @@
 
 #include <string>
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 
 std::string datum_to_infix(Value datum);
 std::string datum_to_tex(Value datum);
 
-// show-expression, ->infix, ->tex-string (eval/builtins_show.cpp).
+// show-expression, ->infix, ->tex-string (builtins/show.cpp).
 void install_show_primitives();
 
 // Shapes of prefix data that both renderers recognize (print/infix.cpp).

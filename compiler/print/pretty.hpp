@@ -22,7 +22,7 @@
 
 #include <string>
 
-#include "eval/value.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 

@@ -1,12 +1,12 @@
 // Printing values as MIT Scheme writes and displays them.
 #include "print/printer.hpp"
 
+#include "base/utf8.hpp"
 #include "syntax/reader.hpp"
-#include "syntax/utf8.hpp"
 
 #include <unordered_map>
 
-#include "eval/number.hpp"
+#include "base/number.hpp"
 #include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 

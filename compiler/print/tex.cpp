@@ -6,7 +6,7 @@
 // self-delimiting, so they need brackets only as the base of a power.
 #include <optional>
 
-#include "eval/number.hpp"
+#include "base/number.hpp"
 #include "print/display_names.hpp"
 #include "print/infix.hpp"
 #include "print/printer.hpp"

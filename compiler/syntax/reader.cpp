@@ -3,8 +3,8 @@
 
 #include <cctype>
 
-#include "eval/number.hpp"
-#include "syntax/utf8.hpp"
+#include "base/number.hpp"
+#include "base/utf8.hpp"
 
 namespace sicm {
 

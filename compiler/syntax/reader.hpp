@@ -17,8 +17,8 @@
 #include <string_view>
 #include <vector>
 
-#include "eval/value.hpp"
-#include "syntax/error.hpp"
+#include "base/error.hpp"
+#include "base/value.hpp"
 
 namespace sicm {
 

@@ -2,7 +2,7 @@
  * primitives' drivers (see sicm/program.h).
  *
  * Each driver mirrors the interpreter's primitive of the same name
- * (compiler/eval/builtins_numerics.cpp): the same defaults, the same way of
+ * (compiler/builtins/numerics.cpp): the same defaults, the same way of
  * restarting integrators and of placing monitor times, the same relaxation
  * of an integral's tolerance. Kernels are adapted to the runtime's callback
  * types by the small functions below; the runtime's error hook records the

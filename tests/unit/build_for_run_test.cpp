@@ -1,4 +1,4 @@
-// Unit tests of compile_for_run (eval/build_for_run.cpp): a procedure of one
+// Unit tests of compile_for_run (pe/for_run.cpp): a procedure of one
 // real compiled by the partial evaluator for sicm run, loops included, and
 // refused, with the heap as it was, when tracing it once would do its
 // effects once.
@@ -7,10 +7,10 @@
 #include <cmath>
 #include <string>
 
-#include "eval/build.hpp"
+#include "base/number.hpp"
 #include "eval/interp.hpp"
-#include "eval/number.hpp"
 #include "eval/procedure.hpp"
+#include "pe/build.hpp"
 #include "print/printer.hpp"
 #include "syntax/reader.hpp"
 

@@ -11,11 +11,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/number.hpp"
 #include "codegen/emit_c.hpp"
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/interp.hpp"
-#include "eval/number.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 #include "syntax/reader.hpp"
@@ -339,7 +339,8 @@ TEST(Codegen, ProductWithAnExactZeroIsZero) {
   Symbol *x = make_uninterned_symbol("x0").symbol();
   ExprId zero = expr_apply(Op::Mul, {expr_integer(-1), expr_integer(0)});
   ExprId out = expr_apply(Op::Atan, {zero, expr_symbol(x)});
-  std::string c = emit_c_assignments({out}, {"out[0]"}, [](Symbol *) { return "in[0]"; }, "t", "");
+  std::string c = emit_c_assignments(
+      {out}, {"out[0]"}, [](Symbol *) { return "in[0]"; }, "t", "");
   EXPECT_EQ(c.find("-0.0"), std::string::npos) << c;
   EXPECT_EQ(c.find("-1.0"), std::string::npos) << c;
   EXPECT_NE(c.find("atan2(0.0, in[0])"), std::string::npos) << c;
@@ -356,7 +357,8 @@ TEST(Codegen, ExactZeroGoesThroughNegationAndFunctions) {
   ExprId root = expr_apply(Op::Sqrt, {expr_apply(Op::Atan, {negated, negated})});
   ExprId cube = expr_apply(Op::Expt, {expr_apply(Op::Sin, {negated}), expr_integer(3)});
   ExprId out = expr_apply(Op::Add, {x0, expr_apply(Op::Atan, {cube, x0}), root});
-  std::string c = emit_c_assignments({out}, {"out[0]"}, [](Symbol *) { return "in[0]"; }, "t", "");
+  std::string c = emit_c_assignments(
+      {out}, {"out[0]"}, [](Symbol *) { return "in[0]"; }, "t", "");
   EXPECT_EQ(c.find("-0.0"), std::string::npos) << c;
   EXPECT_EQ(c.find("-("), std::string::npos) << c;
   EXPECT_EQ(c.find("sqrt"), std::string::npos) << c;
@@ -371,15 +373,16 @@ TEST(Codegen, ExactZeroGoesThroughNegationAndFunctions) {
 TEST(Codegen, ConstantNodesHaveTheirGenericValue) {
   Symbol *x = make_uninterned_symbol("x0").symbol();
   ExprId root = expr_apply(Op::Sqrt, {expr_symbol(x)});
-  ExprId atan_zero =
-      expr_apply(Op::Atan, {expr_integer(0), expr_apply(Op::Expt, {expr_integer(3), expr_integer(-6)})});
+  ExprId atan_zero = expr_apply(
+      Op::Atan, {expr_integer(0), expr_apply(Op::Expt, {expr_integer(3), expr_integer(-6)})});
   ExprId sum_zero = expr_apply(Op::Add, {expr_integer(1), expr_integer(-1)});
-  ExprId atan_pi =
-      expr_apply(Op::Atan, {expr_integer(0), expr_apply(Op::Expt, {expr_integer(-3), expr_integer(-5)})});
+  ExprId atan_pi = expr_apply(
+      Op::Atan, {expr_integer(0), expr_apply(Op::Expt, {expr_integer(-3), expr_integer(-5)})});
   ExprId outs[] = {expr_apply(Op::Mul, {root, atan_zero}), expr_apply(Op::Mul, {sum_zero, root}),
                    expr_apply(Op::Mul, {root, atan_pi})};
-  std::string c = emit_c_assignments({outs[0], outs[1], outs[2]}, {"out[0]", "out[1]", "out[2]"},
-                                     [](Symbol *) { return "in[0]"; }, "t", "");
+  std::string c = emit_c_assignments(
+      {outs[0], outs[1], outs[2]}, {"out[0]", "out[1]", "out[2]"}, [](Symbol *) { return "in[0]"; },
+      "t", "");
   EXPECT_NE(c.find("out[0] = 0.0;"), std::string::npos) << c;
   EXPECT_NE(c.find("out[1] = 0.0;"), std::string::npos) << c;
   EXPECT_EQ(c.find("out[2] = 0.0;"), std::string::npos) << c;
@@ -396,8 +399,8 @@ TEST(Codegen, NothingUnderAConstantFormGetsATemporary) {
   ExprId chain = expr_apply(Op::Expt, {cube, expr_integer(9)}); // names cube, squares
   ExprId one = expr_apply(Op::Expt, {chain, expr_integer(0)});
   ExprId zero = expr_apply(Op::Mul, {expr_integer(0), chain, chain});
-  std::string c = emit_c_assignments({one, zero}, {"out[0]", "out[1]"},
-                                     [](Symbol *) { return "in[0]"; }, "t", "");
+  std::string c = emit_c_assignments(
+      {one, zero}, {"out[0]", "out[1]"}, [](Symbol *) { return "in[0]"; }, "t", "");
   EXPECT_EQ(c.find("double t"), std::string::npos) << c;
   EXPECT_NE(c.find("out[0] = 1.0;"), std::string::npos) << c;
   EXPECT_NE(c.find("out[1] = 0.0;"), std::string::npos) << c;
@@ -414,8 +417,8 @@ TEST(Codegen, TemporariesAreNotConst) {
   ExprId chain = expr_apply(Op::Div, {expr_integer(1), zero});
   for (int i = 0; i < 4; ++i)
     chain = expr_apply(Op::Expt, {chain, expr_integer(i % 2 ? -4 : 4)});
-  std::string c =
-      emit_c_assignments({chain}, {"out[0]"}, [](Symbol *) { return "in[0]"; }, "t", "");
+  std::string c = emit_c_assignments(
+      {chain}, {"out[0]"}, [](Symbol *) { return "in[0]"; }, "t", "");
   EXPECT_NE(c.find("  double t"), std::string::npos) << c;
   EXPECT_EQ(c.find("const"), std::string::npos) << c;
 }

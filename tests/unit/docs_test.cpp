@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "base/value.hpp"
 #include "eval/interp.hpp"
-#include "eval/value.hpp"
 
 namespace {
 
@@ -102,9 +102,8 @@ TEST(Docs, ArchitectureListsEverySourceFile) {
   for (const char *dir : {"compiler", "runtime", "stdlib"}) {
     for (const auto &entry : std::filesystem::recursive_directory_iterator(dir)) {
       const std::string ext = entry.path().extension().string();
-      if (!entry.is_regular_file() ||
-          (ext != ".cpp" && ext != ".hpp" && ext != ".c" && ext != ".h" && ext != ".def" &&
-           ext != ".sicm"))
+      if (!entry.is_regular_file() || (ext != ".cpp" && ext != ".hpp" && ext != ".c" &&
+                                       ext != ".h" && ext != ".def" && ext != ".sicm"))
         continue;
       const std::string name = entry.path().filename().string();
       EXPECT_NE(map.find("`" + name + "`"), std::string::npos)

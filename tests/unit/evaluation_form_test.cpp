@@ -1,4 +1,4 @@
-// Unit tests of the evaluation form (compiler/codegen/evaluation_form.cpp) and of the decimal
+// Unit tests of the evaluation form (compiler/cas/evaluation_form.cpp) and of the decimal
 // constants that kernel tracing uses (DecimalConstants, algebra/symbolic.hpp).
 #include <gtest/gtest.h>
 
@@ -8,13 +8,13 @@
 #include <unordered_set>
 #include <vector>
 
-#include "algebra/expr.hpp"
 #include "algebra/symbolic.hpp"
+#include "base/number.hpp"
+#include "cas/evaluation_form.hpp"
+#include "cas/expr.hpp"
 #include "codegen/emit_c.hpp"
-#include "codegen/evaluation_form.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/interp.hpp"
-#include "eval/number.hpp"
 #include "expr_evaluate.hpp"
 #include "print/printer.hpp"
 #include "syntax/reader.hpp"

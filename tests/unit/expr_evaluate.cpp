@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "eval/number.hpp"
+#include "base/number.hpp"
 
 namespace sicm {
 

@@ -5,7 +5,7 @@
 #include <functional>
 #include <string>
 
-#include "algebra/expr.hpp"
+#include "cas/expr.hpp"
 
 namespace sicm {
 

@@ -1,8 +1,8 @@
-// Unit tests of the expression DAG (compiler/algebra/expr.cpp): hash-consing, order, invariants.
+// Unit tests of the expression DAG (compiler/cas/expr.cpp): hash-consing, order, invariants.
 #include <gtest/gtest.h>
 
-#include "algebra/expr.hpp"
 #include "algebra/symbolic.hpp"
+#include "cas/expr.hpp"
 
 namespace sicm {
 namespace {

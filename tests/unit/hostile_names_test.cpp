@@ -13,12 +13,12 @@
 
 #include <unistd.h>
 
+#include "base/number.hpp"
 #include "codegen/emit_c.hpp"
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
 #include "codegen/trace.hpp"
 #include "eval/interp.hpp"
-#include "eval/number.hpp"
 #include "eval/procedure.hpp"
 #include "syntax/reader.hpp"
 

@@ -1,4 +1,4 @@
-// The named limits on evaluation (eval/limits.hpp): their flags, each limit
+// The named limits on evaluation (base/limits.hpp): their flags, each limit
 // in the evaluator, and Ctrl-C in the REPL (through pipes and on a terminal).
 #include <gtest/gtest.h>
 
@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "base/error.hpp"
+#include "base/limits.hpp"
 #include "eval/interp.hpp"
-#include "eval/limits.hpp"
-#include "syntax/error.hpp"
 #include "syntax/reader.hpp"
 
 using namespace sicm;
@@ -382,7 +382,7 @@ TEST(LimitsBuild, StepLimitIsACompileError) {
       << err;
 }
 
-// Needs the one-line call of note_residual_statement in builtins_build.cpp's
+// Needs the one-line call of note_residual_statement in pe/build_mode.cpp's
 // emit(); enable it with that.
 TEST(LimitsBuild, ResidualSizeLimitIsACompileError) {
   if (!have_sicm()) GTEST_SKIP() << "no sicm binary at " << sicm_binary();

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "algebra/expr.hpp"
 #include "algebra/symbolic.hpp"
+#include "cas/expr.hpp"
 #include "codegen/kernel_form.hpp"
 #include "codegen/local_rewrite.hpp"
 #include "eval/interp.hpp"

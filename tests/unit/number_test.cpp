@@ -1,12 +1,12 @@
-// Unit tests of the numeric tower (compiler/eval/number.cpp); expected values are MIT Scheme's.
+// Unit tests of the numeric tower (compiler/base/number.cpp); expected values are MIT Scheme's.
 #include <gtest/gtest.h>
 
 #include <initializer_list>
 #include <string>
 
-#include "eval/number.hpp"
+#include "base/error.hpp"
+#include "base/number.hpp"
 #include "eval/primitive.hpp"
-#include "syntax/error.hpp"
 
 namespace sicm {
 namespace {

@@ -201,8 +201,7 @@ void oscillator_series_extended(const long double *y, int order, long double *c,
 TEST(OdeTaylor, ExtendedIsAccurateToLongDouble) {
   const double period = 2 * M_PI;
   const long double want = -sinl((long double)period);
-  sicm_ode *o =
-      sicm_ode_alloc(sicm_ode_step_taylor_extended, 2, unused_rhs, nullptr, 1e-20, 1e-20);
+  sicm_ode *o = sicm_ode_alloc(sicm_ode_step_taylor_extended, 2, unused_rhs, nullptr, 1e-20, 1e-20);
   ASSERT_NE(o, nullptr);
   sicm_ode_set_taylor_extended(o, oscillator_series_extended, nullptr);
   sicm_ode_set_horizon(o, period);

@@ -1,7 +1,7 @@
 // Unit tests of the reader: lexical syntax, positions, and clean errors.
 #include <gtest/gtest.h>
 
-#include "eval/number.hpp"
+#include "base/number.hpp"
 #include "print/printer.hpp"
 #include "syntax/reader.hpp"
 

@@ -1,4 +1,4 @@
-// Unit tests of the simplifier and the prefix printer (compiler/algebra/simplify.cpp,
+// Unit tests of the simplifier and the prefix printer (compiler/cas/simplify.cpp,
 // prefix_form.cpp); expected forms are scmutils'.
 #include <gtest/gtest.h>
 
@@ -8,15 +8,15 @@
 #include <initializer_list>
 #include <string>
 
-#include "algebra/expr.hpp"
-#include "algebra/simplify.hpp"
 #include "algebra/symbolic.hpp"
-#include "eval/number.hpp"
+#include "base/error.hpp"
+#include "base/number.hpp"
+#include "base/srcloc.hpp"
+#include "cas/expr.hpp"
+#include "cas/simplify.hpp"
 #include "expr_evaluate.hpp"
 #include "print/printer.hpp"
-#include "syntax/error.hpp"
 #include "syntax/reader.hpp"
-#include "syntax/srcloc.hpp"
 
 namespace sicm {
 namespace {

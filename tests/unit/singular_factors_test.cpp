@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "algebra/expr.hpp"
 #include "algebra/symbolic.hpp"
 #include "capture_errors.hpp"
+#include "cas/expr.hpp"
 #include "codegen/kernel_form.hpp"
 #include "codegen/singular_factors.hpp"
 #include "eval/interp.hpp"

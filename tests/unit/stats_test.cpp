@@ -31,14 +31,17 @@ TEST(Stats, OneLinePerSiteMethodAndTolerance) {
   sicm_stats_add("x.sicm:3:1", "evolve", "rk8pd", 1e-10, &b, 0.25);
   sicm_stats_add("x.sicm:3:1", "evolve", "bulirsch-stoer", 1e-10, &b, 0.125);
   sicm_stats_add("x.sicm:9:5", "state-advancer", "rk8pd", 1e-10, &b, 0.001);
-  EXPECT_EQ(printed(),
-            "integration statistics (--stats), one line per site, method and tolerance:\n"
-            "x.sicm:3:1: evolve, rk8pd, tolerance .0000000001: 2 calls, 140 steps (6 rejected), 1800 rhs "
-            "evaluations, .75 s\n"
-            "x.sicm:3:1: evolve, bulirsch-stoer, tolerance .0000000001: 1 call, 40 steps (1 rejected), 500 "
-            "rhs evaluations, .125 s\n"
-            "x.sicm:9:5: state-advancer, rk8pd, tolerance .0000000001: 1 call, 40 steps (1 rejected), 500 "
-            "rhs evaluations, .001 s\n");
+  EXPECT_EQ(
+      printed(),
+      "integration statistics (--stats), one line per site, method and tolerance:\n"
+      "x.sicm:3:1: evolve, rk8pd, tolerance .0000000001: 2 calls, 140 steps (6 rejected), 1800 rhs "
+      "evaluations, .75 s\n"
+      "x.sicm:3:1: evolve, bulirsch-stoer, tolerance .0000000001: 1 call, 40 steps (1 rejected), "
+      "500 "
+      "rhs evaluations, .125 s\n"
+      "x.sicm:9:5: state-advancer, rk8pd, tolerance .0000000001: 1 call, 40 steps (1 rejected), "
+      "500 "
+      "rhs evaluations, .001 s\n");
 }
 
 } // namespace

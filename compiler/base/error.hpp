@@ -1,0 +1,57 @@
+// User-facing errors: one exception type, one reporter.
+//
+// Errors a user can cause are thrown as sicm::Error with a location and a
+// message, and printed by report_error() as
+//     file:line:col: error: message
+//         the source line
+//             ^
+// Broken internal invariants are not Errors: they abort (see SICM_ASSERT).
+#pragma once
+
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
+#include "base/srcloc.hpp"
+
+namespace sicm {
+
+enum class ErrorKind {
+  Syntax,  // reader and special-form errors, unknown identifiers: exit 65
+  Runtime, // errors while evaluating: exit 70
+};
+
+// Exit statuses, following sysexits.h as compilers do.
+constexpr int kExitCompileError = 65; // EX_DATAERR
+constexpr int kExitRuntimeError = 70; // EX_SOFTWARE
+
+struct Error : std::runtime_error {
+  ErrorKind kind;
+  SrcLoc loc;
+  std::string note; // optional extra line (e.g. "did you mean ...")
+  Error(ErrorKind k, SrcLoc l, std::string msg, std::string n = {})
+      : std::runtime_error(std::move(msg)), kind(k), loc(l), note(std::move(n)) {}
+  int exit_code() const {
+    return kind == ErrorKind::Syntax ? kExitCompileError : kExitRuntimeError;
+  }
+};
+
+[[noreturn]] void syntax_error(SrcLoc loc, const std::string &msg);
+[[noreturn]] void runtime_error(SrcLoc loc, const std::string &msg);
+
+// The location of the call being evaluated, for errors raised by primitives.
+SrcLoc current_call_loc();
+
+// Print an error in compiler style on stream f (the source line and a caret
+// when the location is known).
+void report_error(std::FILE *f, const Error &e);
+std::string format_error(const Error &e);
+
+[[noreturn]] void internal_failure(const char *file, int line, const char *what);
+#define SICM_ASSERT(cond)                                                                          \
+  do {                                                                                             \
+    if (!(cond)) ::sicm::internal_failure(__FILE__, __LINE__, #cond);                              \
+  } while (0)
+
+} // namespace sicm

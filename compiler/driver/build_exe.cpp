@@ -1,0 +1,225 @@
+// `sicm build`: run in build mode, emit the residual program, call cc (see build_exe.hpp).
+#include "driver/build_exe.hpp"
+
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "base/error.hpp"
+#include "builtins/effects_used.hpp"
+#include "codegen/jit.hpp"
+#include "codegen/kernel_report.hpp"
+#include "codegen/residual_dump.hpp"
+#include "codegen/residual_emit.hpp"
+#include "eval/analyze.hpp"
+#include "eval/analyzed_dump.hpp"
+#include "eval/core.hpp"
+#include "eval/interp.hpp"
+#include "pe/build.hpp"
+#include "syntax/reader.hpp"
+
+extern char **environ;
+
+namespace sicm {
+
+namespace {
+
+constexpr int kExitNoInput = 66;   // EX_NOINPUT
+constexpr int kExitCantCreat = 73; // EX_CANTCREAT
+
+bool exists(const std::string &path) {
+  struct stat st;
+  return stat(path.c_str(), &st) == 0;
+}
+
+std::string dir_of(const std::string &path) {
+  size_t slash = path.rfind('/');
+  return slash == std::string::npos ? "." : path.substr(0, slash);
+}
+
+std::string self_dir() {
+  char buf[4096];
+  ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) return ".";
+  buf[n] = '\0';
+  return dir_of(buf);
+}
+
+// Where the runtime's headers and library are: beside the executable in the
+// build tree, or in the installation prefix.
+bool find_runtime(std::string *include_dir, std::string *library) {
+  std::string bin = self_dir();
+  const std::pair<std::string, std::string> places[] = {
+      {bin + "/../runtime/include", bin + "/libsicmrt.a"},
+      {bin + "/../include", bin + "/../lib/libsicmrt.a"},
+  };
+  for (const auto &[inc, lib] : places)
+    if (exists(inc + "/sicm/runtime.h") && exists(lib)) {
+      *include_dir = inc;
+      *library = lib;
+      return true;
+    }
+  return false;
+}
+
+std::vector<std::string> compiler_command() {
+  std::vector<std::string> words;
+  const char *cc = std::getenv("CC");
+  std::istringstream in(cc ? cc : "");
+  for (std::string w; in >> w;)
+    words.push_back(w);
+  if (words.empty()) words.push_back("cc");
+  return words;
+}
+
+// Run argv (stdout and stderr inherited); the exit status, or -1.
+int run(const std::vector<std::string> &argv) {
+  std::vector<char *> cargv;
+  for (const std::string &a : argv)
+    cargv.push_back(const_cast<char *>(a.c_str()));
+  cargv.push_back(nullptr);
+  pid_t pid;
+  if (posix_spawnp(&pid, cargv[0], nullptr, nullptr, cargv.data(), environ) != 0) return -1;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+std::string base_name(const std::string &path) {
+  size_t slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+} // namespace
+
+int build_program(const BuildOptions &o) {
+  std::ifstream in(o.input, std::ios::binary);
+  if (!in) {
+    std::fprintf(stderr, "sicm: cannot open %s: %s\n", o.input.c_str(), std::strerror(errno));
+    return kExitNoInput;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  uint32_t file = register_source(o.input, text.str());
+
+  if (o.dump == "analyzed") {
+    for (const ReadForm &f : read_all(file))
+      std::printf("%s\n", dump_node(analyze_form(f.datum, f.loc, nullptr)).c_str());
+    return 0;
+  }
+  ResidualProgram program;
+  program.source_name = base_name(o.input);
+  begin_build_mode(&program);
+  run_source(file);
+  if (o.dump == "residual") {
+    std::fputs(dump_residual(program).c_str(), stdout);
+    return 0;
+  }
+  std::string c = emit_residual_program(program);
+  if (o.dump == "kernels") {
+    std::fputs(report_table(report_kernels(program, c), used_effects()).c_str(), stdout);
+    return 0;
+  }
+  if (o.dump == "c") {
+    std::fwrite(c.data(), 1, c.size(), stdout);
+    return 0;
+  }
+
+  if (!o.report_path.empty()) {
+    std::vector<KernelReport> kernels = report_kernels(program, c);
+    std::ofstream json(o.report_path, std::ios::binary);
+    json << report_json(kernels, used_effects());
+    if (!json) {
+      std::fprintf(stderr, "sicm: error: cannot write %s\n", o.report_path.c_str());
+      return kExitCantCreat;
+    }
+    if (o.report_only) {
+      std::fputs(report_table(kernels, used_effects()).c_str(), stdout);
+      std::printf("wrote %s\n", o.report_path.c_str());
+      return 0;
+    }
+  }
+  if (o.emit_only) {
+    std::fwrite(c.data(), 1, c.size(), stdout);
+    return 0;
+  }
+  std::string include_dir, library;
+  if (!find_runtime(&include_dir, &library)) {
+    std::fprintf(stderr,
+                 "sicm: error: cannot find the runtime library (libsicmrt.a and sicm/runtime.h) "
+                 "beside %s\n",
+                 self_dir().c_str());
+    return kExitCantCreat;
+  }
+  std::string c_path = o.output + ".c";
+  bool keep = o.keep_c;
+  if (!keep) {
+    char tmpl[] = "/tmp/sicm-build-XXXXXX";
+    int fd = mkstemp(tmpl);
+    if (fd < 0) {
+      std::fprintf(stderr, "sicm: error: cannot create a temporary file: %s\n",
+                   std::strerror(errno));
+      return kExitCantCreat;
+    }
+    close(fd);
+    std::remove(tmpl);
+    c_path = std::string(tmpl) + ".c";
+  }
+  {
+    std::ofstream out(c_path, std::ios::binary);
+    out << c;
+    if (!out) {
+      std::fprintf(stderr, "sicm: error: cannot write %s\n", c_path.c_str());
+      return kExitCantCreat;
+    }
+  }
+  std::vector<std::string> argv = compiler_command();
+  std::vector<std::string> mpi_flags;
+  if (o.mpi) {
+    // Open MPI's wrapper compiler adds its headers and libraries to the
+    // C compiler the user chose ($CC is passed on as OMPI_CC).
+    std::string mpi_library = dir_of(library) + "/libsicmrt_mpi.a";
+    if (!exists(mpi_library)) {
+      std::fprintf(stderr,
+                   "sicm: error: --mpi: this sicm was built without MPI (%s is missing); install "
+                   "libopenmpi-dev and rebuild sicm\n",
+                   mpi_library.c_str());
+      if (!keep) std::remove(c_path.c_str());
+      return kExitCantCreat;
+    }
+    const char *mpicc = std::getenv("SICM_MPICC");
+    if (const char *cc = std::getenv("CC")) setenv("OMPI_CC", cc, 0);
+    argv = {mpicc && *mpicc ? mpicc : "mpicc"};
+    mpi_flags = {"-DSICM_MPI", mpi_library};
+  }
+  // The generated C never needs to shadow a name: a declaration that hides a
+  // hoisted variable once made a built program print 0. where sicm run
+  // printed the value. -Werror=shadow makes such a bug fail the build.
+  argv.insert(argv.end(), {"-std=c11", "-Werror=shadow", o.opt_level, "-o", o.output, c_path,
+                           "-I" + include_dir});
+  argv.insert(argv.end(), mpi_flags.begin(), mpi_flags.end());
+  argv.insert(argv.end(), {library, "-lsundials_cvode", "-lsundials_nvecserial", "-lgsl",
+                           "-lgslcblas", "-lm", "-lpthread"});
+  std::vector<std::string> sanitize = sanitizer_flags();
+  argv.insert(argv.begin() + 1, sanitize.begin(), sanitize.end());
+  int status = run(argv);
+  if (!keep) std::remove(c_path.c_str());
+  if (status != 0) {
+    std::fprintf(stderr, "sicm: error: the C compiler '%s' %s\n", argv[0].c_str(),
+                 status < 0 ? "could not be started" : "failed on the generated C");
+    return kExitCantCreat;
+  }
+  return 0;
+}
+
+} // namespace sicm

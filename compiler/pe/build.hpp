@@ -1,0 +1,39 @@
+// `sicm build`'s evaluator mode: the program runs at compile time and what
+// depends on numerical results is recorded as a residual program (see
+// codegen/residual.hpp and pe/build_mode.cpp).
+#pragma once
+
+#include <string>
+
+#include "codegen/residual.hpp"
+
+namespace sicm {
+
+// Rebind the primitives and install the evaluator's hooks so that what runs
+// from now on records into `program` (which must outlive the run). Call
+// after init_interpreter, before running the program.
+void begin_build_mode(ResidualProgram *program);
+
+// Back to sicm run: the primitives and hooks as they were before
+// begin_build_mode, and the build's state empty. Run-time values made
+// during the build must not have reached anything that outlives it (see
+// compile_for_run in pe/for_run.cpp, which ensures it).
+void end_build_mode();
+
+// Is a build going on (between begin_build_mode and end_build_mode)?
+bool in_build_mode();
+
+// A procedure of one real compiled for sicm run: writes f(in[0]) to out[0]
+// and returns 0, or returns 1 where the interpreter must compute the value
+// (a checked operation would leave the reals: division by zero, the square
+// root of a negative number).
+using CompiledScalarFn = int (*)(const double *in, double *out);
+
+// sicm run: f (a procedure of one real returning a real) compiled by the
+// partial evaluator and loaded, or null with the reason in *why_not when it
+// cannot be (it has effects, calls numerical primitives, or no C compiler
+// works). The interpreter's heap is as it was either way. who: the
+// primitive that asks (for messages). See pe/for_run.cpp.
+CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not);
+
+} // namespace sicm

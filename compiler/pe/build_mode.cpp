@@ -1,0 +1,793 @@
+// `sicm build`: the evaluator's primitives and hooks that turn a run into a
+// residual program (see codegen/residual.hpp for the idea).
+//
+// begin_build_mode() rebinds the primitives whose meaning changes: the
+// numerical primitives record a statement and return fresh run-time values;
+// plots record their statements; comparisons, floor, max and min of run-time
+// values become statements; printing names the run-time values it prints.
+// The evaluator's branch hooks make `if`, `and` and `or` on a run-time truth
+// value evaluate both alternatives and select between their values at run
+// time. Everything else runs as it always does, at compile time.
+//
+// What cannot be left for run time is a compile error ("cannot compile")
+// naming the construct, its place in the source, and that `sicm run`
+// interprets it:
+//   - an effect (output, a plot mark, a numerical primitive, set! of a
+//     global) under a test on a run-time value: both alternatives are
+//     evaluated, so an effect would happen whichever way the test goes;
+//   - a loop or recursion whose exit depends on a run-time value (it would
+//     unfold without end; see kMaxBranchDepth);
+//   - set! of a global variable inside a procedure traced for run time (the
+//     procedure runs once at compile time, not each time it is called) to
+//     anything but a number or truth value (a cell) or (cons x l) with l
+//     the variable's list (a run-time list; see "lists whose length is
+//     known only at run time" in pe/lists.cpp);
+//   - a run-time value where a static one is needed (a frame's bounds, a
+//     list index) or that escapes the procedure it was computed in.
+//
+// Loops whose iterations do run-time work are unrolled at compile time up to
+// two named limits (base/limits.hpp, flags of sicm build), past which they
+// are generalized into C loops instead (never an error: see
+// "generalization" in pe/loops.cpp):
+//   kMaxUnrolledElements   = 32  --max-unrolled-elements: map and for-each
+//                                over a longer list of inexact numbers;
+//   kMaxUnrolledIterations = 64  --max-unrolled-iterations: a named procedure
+//                                called with known arguments that calls
+//                                itself more often.
+//
+// The code is in these files, which share what pe/state.hpp declares:
+//   pe/build_mode.cpp   run-time values, statements, cells, output, the
+//                        rebound primitives and begin_build_mode (this file)
+//   pe/numerics.cpp   tracing procedures into functions; the numerical
+//                        primitives (integrals, minimizers, roots, state
+//                        advancers, evolve)
+//   pe/plots.cpp      frame, plot-point, plot-line, graphics-close
+//   pe/branches.cpp   tests on run-time values (if, and, or) and set!
+//   pe/loops.cpp      loops left for run time: named procedures called
+//                        again with run-time arguments, generalization past
+//                        the unroll limits, loops that start from known values
+//   pe/lists.cpp      lists whose length is known only at run time
+#include "pe/build.hpp"
+
+#include <algorithm>
+#include <functional>
+#include <string>
+#include <unordered_map>
+
+#include "algebra/linear_solve.hpp"
+#include "algebra/structure.hpp"
+#include "base/limits.hpp"
+#include "base/number.hpp"
+#include "builtins/parameter.hpp"
+#include "codegen/state_shape.hpp"
+#include "eval/core.hpp"
+#include "eval/interp.hpp"
+#include "eval/primitive.hpp"
+#include "eval/procedure.hpp"
+#include "pe/state.hpp"
+#include "print/printer.hpp"
+
+namespace sicm::build {
+
+namespace {
+
+const char kMarkerPrefix[] = "__sicm_rt";
+const char kMarkerSuffix[] = "__";
+
+} // namespace
+
+ResidualProgram *g_prog = nullptr;
+std::vector<int> g_open;                    // functions being traced, innermost last
+std::unordered_map<Symbol *, int> g_var_of; // residual variable of a symbol
+int g_branch_depth = 0;
+
+[[noreturn]] void cannot_compile(SrcLoc loc, const std::string &what) {
+  throw Error(ErrorKind::Syntax, loc, "cannot compile: " + what,
+              "sicm build leaves only numerical work for run time; `sicm run` interprets this "
+              "program");
+}
+
+SrcLoc here() {
+  SrcLoc loc = current_call_loc();
+  return loc.known() ? loc : current_toplevel_loc();
+}
+
+RFunction &current() {
+  return g_prog->functions[g_open.back()];
+}
+
+// Where statements go: the innermost open function's body, or the block of
+// an alternative under a run-time test being evaluated (owned by
+// hook_branch's frame). Function bodies are found by index: the function
+// vector grows while they are open.
+std::vector<std::vector<RStmt> *> g_blocks; // null: the open function's body
+
+std::vector<RStmt> &current_block() {
+  std::vector<RStmt> *b = g_blocks.empty() ? nullptr : g_blocks.back();
+  return b ? *b : current().body;
+}
+
+// ---- run-time values ----------------------------------------------------------------
+
+namespace {
+
+void write_rtlist(std::string &out, const void *, bool) {
+  out += "#[list of run-time length]";
+}
+
+const OpaqueKind kRtListKind = {"run-time-list", write_rtlist, nullptr};
+
+// Does the expression mention a residual variable? (Memoized: the arena
+// only grows and nodes never change.)
+bool expr_is_dynamic(ExprId root) {
+  static std::unordered_map<ExprId, bool> memo;
+  auto hit = memo.find(root);
+  if (hit != memo.end()) return hit->second;
+  bool dynamic = false;
+  const ExprNode &n = expr_node(root);
+  switch (n.kind) {
+  case ExprKind::Rational:
+  case ExprKind::Flonum: break;
+  case ExprKind::Symbol: dynamic = g_var_of.count(n.sym) > 0; break;
+  case ExprKind::Apply:
+  case ExprKind::Call: {
+    std::vector<ExprId> args = expr_arg_vector(root);
+    if (n.kind == ExprKind::Call) args.push_back(n.head);
+    for (ExprId a : args)
+      if (expr_is_dynamic(a)) {
+        dynamic = true;
+        break;
+      }
+    break;
+  }
+  }
+  memo[root] = dynamic;
+  return dynamic;
+}
+
+// How a number, truth value or run-time value would be printed: an
+// expression of counts (exact integers combined by + and *) is a count.
+RType expr_type(ExprId id) {
+  const ExprNode &n = expr_node(id);
+  switch (n.kind) {
+  case ExprKind::Rational: return expr_is_exact_integer(id) ? RType::Integer : RType::Real;
+  case ExprKind::Flonum: return RType::Real;
+  case ExprKind::Symbol: {
+    auto it = g_var_of.find(n.sym);
+    return it == g_var_of.end() ? RType::Real : g_prog->vars[it->second].type;
+  }
+  case ExprKind::Apply:
+    if (n.op == Op::Add || n.op == Op::Mul) {
+      for (ExprId a : expr_arg_vector(id))
+        if (expr_type(a) != RType::Integer) return RType::Real;
+      return RType::Integer;
+    }
+    return RType::Real;
+  case ExprKind::Call: return RType::Real;
+  }
+  return RType::Real;
+}
+
+} // namespace
+
+Value new_var(RType type) {
+  int id = static_cast<int>(g_prog->vars.size());
+  Value sym = make_uninterned_symbol(kMarkerPrefix + std::to_string(id) + kMarkerSuffix);
+  g_prog->vars.push_back(RVar{sym.symbol(), type, id, g_open.back()});
+  g_var_of[sym.symbol()] = id;
+  return sym;
+}
+
+int var_of(Value v) {
+  if (!v.is(Tag::Symbol)) return -1;
+  auto it = g_var_of.find(v.symbol());
+  return it == g_var_of.end() ? -1 : it->second;
+}
+
+RtList *as_rtlist(Value v) {
+  if (!v.is(Tag::Opaque) || v.as<Opaque>()->kind != &kRtListKind) return nullptr;
+  return static_cast<RtList *>(v.as<Opaque>()->obj);
+}
+
+Value make_rtlist(int list, bool reversed, bool whole, Value start, Value end) {
+  RtList *r = gc_new<RtList>(RtList{list, reversed, whole, start, end});
+  return Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kRtListKind, r}));
+}
+
+bool is_dynamic_scalar(Value v) {
+  if (var_of(v) >= 0) return true;
+  return v.is(Tag::Expr) && expr_is_dynamic(static_cast<ExprId>(v.i));
+}
+
+bool is_dynamic_boolean(Value v) {
+  int id = var_of(v);
+  return id >= 0 && g_prog->vars[id].type == RType::Boolean;
+}
+
+bool contains_dynamic(Value v) {
+  if (is_dynamic_scalar(v) || as_rtlist(v)) return true;
+  if (is_structure(v)) {
+    Structure *s = as_structure(v);
+    for (size_t i = 0; i < s->len; ++i)
+      if (contains_dynamic(s->items[i])) return true;
+    return false;
+  }
+  if (is_pair(v)) return contains_dynamic(car(v)) || contains_dynamic(cdr(v));
+  if (v.is(Tag::Vector)) {
+    Vector *vec = v.vector();
+    for (size_t i = 0; i < vec->len; ++i)
+      if (contains_dynamic(vec->items[i])) return true;
+  }
+  return false;
+}
+
+std::string describe(Value v) {
+  std::string s = write_string(v);
+  for (size_t m; (m = s.find(kMarkerPrefix)) != std::string::npos;) {
+    size_t end = s.find(kMarkerSuffix, m + sizeof kMarkerPrefix - 1);
+    if (end == std::string::npos) break;
+    s.replace(m, end + sizeof kMarkerSuffix - 1 - m, "<run-time number>");
+  }
+  if (s.size() > 60) s = s.substr(0, 60) + "...";
+  return s;
+}
+
+// A number, a boolean or a run-time value as an expression node.
+ExprId expr_of(Value v, const char *who) {
+  if (is_number(v)) return expr_from_number(v);
+  if (v.is(Tag::Bool)) return expr_integer(v.truthy() ? 1 : 0);
+  if (var_of(v) >= 0) return expr_symbol(v.symbol());
+  if (v.is(Tag::Expr) && expr_is_dynamic(static_cast<ExprId>(v.i))) return static_cast<ExprId>(v.i);
+  cannot_compile(here(), std::string(who) + " needs a number here, not " + describe(v));
+}
+
+RType scalar_type(Value v) {
+  if (v.is(Tag::Bool)) return RType::Boolean;
+  int id = var_of(v);
+  if (id >= 0) return g_prog->vars[id].type;
+  if (v.is(Tag::Fixnum) || v.is(Tag::Bignum)) return RType::Integer;
+  if (v.is(Tag::Expr)) return expr_type(static_cast<ExprId>(v.i));
+  return RType::Real;
+}
+
+bool is_scalar(Value v) {
+  return is_number(v) || v.is(Tag::Bool) || is_dynamic_scalar(v);
+}
+
+// ---- statements ---------------------------------------------------------------------
+
+uint64_t g_work = 0; // statements recorded other than output text (see StaticWatch)
+
+void emit(RStmt s) {
+  if (!s.loc.known()) s.loc = here();
+  std::vector<RStmt> &body = current_block();
+  if (s.kind == RKind::Text && !body.empty() && body.back().kind == RKind::Text) {
+    body.back().text += s.text;
+    return;
+  }
+  // A statement after a loop's "continue" in the same block: the recursive
+  // call was not in tail position (its result is not the loop's), so the
+  // call is not a loop (LoopAbort is caught by the loop attempt).
+  if (!body.empty() && body.back().kind == RKind::Continue) throw_not_a_loop();
+  note_residual_statement(s.loc); // --max-residual-size
+  if (s.kind != RKind::Text) ++g_work;
+  bool calls = s.callee >= 0 || s.monitor >= 0;
+  body.push_back(std::move(s));
+  if (calls) read_cells(); // the call may have assigned them
+}
+
+// ---- cells: globals that procedures run at run time assign ----------------------------
+//
+// A set! of a global inside a traced procedure makes the global a cell (a C
+// global): the procedure is traced again from the start, now reading the
+// cell where it begins, and every function reads the cells again after each
+// call that may have assigned them. Only numbers and truth values can live
+// in a cell.
+
+std::vector<bool> g_cell_initialized;
+
+int cell_of(Value *place) {
+  for (size_t i = 0; i < g_prog->cells.size(); ++i)
+    if (g_prog->cells[i].place == place) return static_cast<int>(i);
+  return -1;
+}
+
+gcvec<Frame *> g_cell_frames; // keeps the frames of local cells alive (a scanned vector)
+std::vector<uint32_t> g_function_serials; // g_frame_serial when each open function began
+
+void set_cell(int cell, Value v) {
+  RStmt s{RKind::SetCell};
+  s.cell = cell;
+  s.args = {expr_of(v, "set!")};
+  emit(std::move(s));
+}
+
+// Make every cell's global hold a fresh read of the cell in the current function.
+void read_cells() {
+  read_list_cells();
+  for (size_t i = 0; i < g_prog->cells.size(); ++i) {
+    if (!g_cell_initialized[i]) continue;
+    RStmt s{RKind::Let};
+    s.compute = RCompute::ReadCell;
+    s.cell = static_cast<int>(i);
+    Value v = new_var(g_prog->cells[i].type);
+    s.var = var_of(v);
+    current_block().push_back(std::move(s));
+    *g_prog->cells[i].place = v;
+  }
+}
+
+// Run a numerical primitive, tracing it again whenever a traced procedure
+// turns a global into a cell (or widens a cell from counts to reals).
+ProgramMark mark_program() {
+  return {g_prog->functions.size(), g_prog->vars.size(), current().body.size()};
+}
+
+void rewind_program(const ProgramMark &mark) {
+  for (size_t v = mark.nvars; v < g_prog->vars.size(); ++v)
+    g_var_of.erase(g_prog->vars[v].sym);
+  g_prog->functions.resize(mark.nfunctions);
+  g_prog->vars.resize(mark.nvars);
+  std::vector<RStmt> &body = current().body;
+  body.erase(body.begin() + static_cast<long>(mark.nbody), body.end());
+}
+
+Value with_retrace(const std::function<Value()> &body) {
+  size_t depth = g_open.size();
+  if (depth != 1) return body(); // the outermost primitive retraces
+  // The primitive's call site: tracing its procedures moves the evaluator's
+  // idea of the current call into them, and a retrace must not take that
+  // for the primitive's place (its errors and sites name the call).
+  const SrcLoc call = current_call_loc();
+  for (;;) {
+    ProgramMark mark = mark_program();
+    reset_call_loc(call);
+    try {
+      return body();
+    } catch (const Retrace &) {
+      rewind_program(mark);
+      for (size_t i = 0; i < g_prog->cells.size(); ++i) {
+        if (g_cell_initialized[i]) continue;
+        g_cell_initialized[i] = true;
+        set_cell(static_cast<int>(i), *g_prog->cells[i].place);
+      }
+      init_list_cells();
+    }
+  }
+}
+
+bool is_cannot_compile(const Error &e) {
+  return e.kind == ErrorKind::Syntax && std::string_view(e.what()).starts_with("cannot compile: ");
+}
+
+Value let(RCompute c, std::vector<ExprId> args, RType type) {
+  Value v = new_var(type);
+  RStmt s{RKind::Let};
+  s.compute = c;
+  s.args = std::move(args);
+  s.var = var_of(v);
+  emit(std::move(s));
+  return v;
+}
+
+// ---- output ---------------------------------------------------------------------------
+
+namespace {
+
+// A run-time scalar as a variable (an expression gets a Let).
+Value as_var(Value v) {
+  if (var_of(v) >= 0) return v;
+  return let(RCompute::Expr, {expr_of(v, "printing")}, scalar_type(v)); // a sum of counts is one
+}
+
+// Output text; names of run-time variables in it (printed from a value
+// prepared by prepare_for_print) become Print statements.
+void residual_output(std::string_view s) {
+  size_t pos = 0;
+  while (pos < s.size()) {
+    size_t m = s.find(kMarkerPrefix, pos);
+    size_t digits = m == std::string_view::npos ? m : m + sizeof kMarkerPrefix - 1;
+    size_t end = digits;
+    while (end != std::string_view::npos && end < s.size() && s[end] >= '0' && s[end] <= '9')
+      ++end;
+    bool marker = m != std::string_view::npos && end > digits &&
+                  s.substr(end, sizeof kMarkerSuffix - 1) == kMarkerSuffix;
+    if (!marker) {
+      size_t stop = m == std::string_view::npos ? s.size() : m + 1;
+      RStmt t{RKind::Text};
+      t.text = std::string(s.substr(pos, stop - pos));
+      emit(std::move(t));
+      pos = stop;
+      continue;
+    }
+    if (m > pos) {
+      RStmt t{RKind::Text};
+      t.text = std::string(s.substr(pos, m - pos));
+      emit(std::move(t));
+    }
+    RStmt p{RKind::Print};
+    p.var = std::stoi(std::string(s.substr(digits, end - digits)));
+    emit(std::move(p));
+    pos = end + sizeof kMarkerSuffix - 1;
+  }
+}
+
+// v with every run-time expression in it replaced by a variable, so that
+// printing it prints variable names (markers) where numbers will be.
+Value prepare_for_print(Value v) {
+  if (is_dynamic_scalar(v)) return as_var(v);
+  if (as_rtlist(v))
+    cannot_compile(here(), "printing " + describe(v) +
+                               ", a list whose length is known only at run time (print its "
+                               "elements with for-each)");
+  if (is_structure(v)) {
+    if (!contains_dynamic(v)) return v;
+    Structure *s = as_structure(v);
+    gcvec<Value> items(s->items, s->items + s->len);
+    for (Value &x : items)
+      x = prepare_for_print(x);
+    return make_structure_from(s->up, items.data(), items.size());
+  }
+  if (is_pair(v)) {
+    if (!contains_dynamic(v)) return v;
+    return cons(prepare_for_print(car(v)), prepare_for_print(cdr(v)));
+  }
+  if (v.is(Tag::Vector) && contains_dynamic(v)) {
+    Vector *vec = v.vector();
+    Value out = make_vector(vec->len, Value::fixnum(0));
+    for (size_t i = 0; i < vec->len; ++i)
+      out.vector()->items[i] = prepare_for_print(vec->items[i]);
+    return out;
+  }
+  return v;
+}
+
+} // namespace
+
+// ---- the primitives that are rebound ---------------------------------------------------
+
+namespace {
+
+std::unordered_map<std::string, PrimFn> g_original;
+
+PrimFn original(const char *name) {
+  return g_original.at(name);
+}
+
+// Printing primitives: prepare the value, then print it as always.
+template <const char *Name> Value P_print(Value *a, int n) {
+  gcvec<Value> args(a, a + n);
+  if (n > 0) args[0] = prepare_for_print(args[0]);
+  return call_original(Name, args.data(), n);
+}
+constexpr char kDisplay[] = "display";
+constexpr char kWrite[] = "write";
+constexpr char kWriteLine[] = "write-line";
+constexpr char kPp[] = "pp";
+constexpr char kPrintExpression[] = "print-expression";
+constexpr char kPe[] = "pe";
+
+bool any_dynamic(Value *a, int n) {
+  for (int i = 0; i < n; ++i)
+    if (is_dynamic_scalar(a[i]) || is_dynamic_boolean(a[i])) return true;
+  return false;
+}
+
+// x and y, either possibly a run-time truth value.
+Value both(Value x, Value y, const char *who) {
+  if (!is_dynamic_boolean(x) && !is_dynamic_boolean(y))
+    return Value::boolean(x.truthy() && y.truthy());
+  if (!is_dynamic_boolean(x)) return x.truthy() ? y : x;
+  if (!is_dynamic_boolean(y)) return y.truthy() ? x : y;
+  return let(RCompute::Select, {expr_of(x, who), expr_of(y, who), expr_integer(0)}, RType::Boolean);
+}
+
+// a0 op a1 op a2 ...: the conjunction of the pairwise comparisons.
+Value compare_chain(Value *a, int n, RCompute c, bool swap, const char *who) {
+  Value result = Value::boolean(true);
+  for (int i = 0; i + 1 < n; ++i) {
+    Value x = a[swap ? i + 1 : i], y = a[swap ? i : i + 1];
+    Value r;
+    if (!is_dynamic_scalar(x) && !is_dynamic_scalar(y)) {
+      Value pair[2] = {a[i], a[i + 1]};
+      r = call_original(who, pair, 2);
+    } else {
+      r = let(c, {expr_of(x, who), expr_of(y, who)}, RType::Boolean);
+    }
+    result = i == 0 ? r : both(result, r, who);
+  }
+  return result;
+}
+
+template <const char *Name, RCompute C, bool Swap> Value P_compare(Value *a, int n) {
+  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  return compare_chain(a, n, C, Swap, Name);
+}
+constexpr char kLess[] = "<";
+constexpr char kGreater[] = ">";
+constexpr char kLessEq[] = "<=";
+constexpr char kGreaterEq[] = ">=";
+constexpr char kEqual[] = "=";
+
+// A scalar's kind as eqv? sees it: a truth value, an exact number, an
+// inexact one.
+RType scalar_kind(Value v) {
+  if (is_dynamic_scalar(v) || is_dynamic_boolean(v)) return scalar_type(v);
+  if (v.is(Tag::Bool)) return RType::Boolean;
+  return v.is(Tag::Flonum) ? RType::Real : RType::Integer;
+}
+
+// eq?, eqv? and equal? where run-time values are compared: two numbers at
+// run time (a run-time number is never the same as anything not a number);
+// equal? also walks pairs, structures and vectors, comparing the leaves
+// pairwise. Without this the comparison would be of the expressions that
+// stand for the values, and two lists of equal run-time numbers would be
+// different at compile time.
+Value same(Value a, Value b, bool deep, const char *who) {
+  bool da = is_dynamic_scalar(a) || is_dynamic_boolean(a),
+       db = is_dynamic_scalar(b) || is_dynamic_boolean(b);
+  if (da || db) {
+    // What kind of scalar each is, is known now: eqv? of an inexact number
+    // (a run-time number is one, unless it counts) and an exact one is #f.
+    if (!is_scalar(a) || !is_scalar(b) || scalar_kind(a) != scalar_kind(b))
+      return Value::boolean(false);
+    return let(RCompute::Equal, {expr_of(a, who), expr_of(b, who)}, RType::Boolean);
+  }
+  if (!deep || (!contains_dynamic(a) && !contains_dynamic(b))) {
+    Value pair[2] = {a, b};
+    return call_original(who, pair, 2);
+  }
+  if (as_rtlist(a) || as_rtlist(b))
+    cannot_compile(here(), std::string(who) + " of a list whose length is known only at run time");
+  if (is_pair(a) || is_pair(b)) {
+    if (!is_pair(a) || !is_pair(b)) return Value::boolean(false);
+    Value first = same(car(a), car(b), deep, who);
+    if (!is_dynamic_boolean(first) && !first.truthy()) return first;
+    return both(first, same(cdr(a), cdr(b), deep, who), who);
+  }
+  size_t la = 0, lb = 0;
+  Value *x = container_items(a, &la), *y = container_items(b, &lb);
+  if (!x || !y || la != lb || a.tag != b.tag) return Value::boolean(false);
+  if (is_structure(a) && as_structure(a)->up != as_structure(b)->up) return Value::boolean(false);
+  Value result = Value::boolean(true);
+  for (size_t i = 0; i < la; ++i)
+    result = both(result, same(x[i], y[i], deep, who), who);
+  return result;
+}
+
+template <const char *Name, bool Deep> Value P_same(Value *a, int n) {
+  if (!contains_dynamic(a[0]) && !contains_dynamic(a[1])) return call_original(Name, a, n);
+  return same(a[0], a[1], Deep, Name);
+}
+constexpr char kEqP[] = "eq?";
+constexpr char kEqvP[] = "eqv?";
+constexpr char kEqualP[] = "equal?";
+
+template <const char *Name, RCompute C, bool Swap> Value P_sign_test(Value *a, int n) {
+  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  Value args[2] = {a[0], Value::fixnum(0)};
+  return compare_chain(args, 2, C, Swap, Name);
+}
+constexpr char kZero[] = "zero?";
+constexpr char kPositive[] = "positive?";
+constexpr char kNegative[] = "negative?";
+
+template <const char *Name, RCompute C> Value P_unary(Value *a, int n) {
+  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  return let(C, {expr_of(a[0], Name)}, RType::Real);
+}
+constexpr char kFloor[] = "floor";
+constexpr char kRound[] = "round";
+constexpr char kTruncate[] = "truncate";
+
+template <const char *Name, RCompute C> Value P_fold(Value *a, int n) {
+  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  Value acc = a[0];
+  for (int i = 1; i < n; ++i)
+    acc = let(C, {expr_of(acc, Name), expr_of(a[i], Name)}, RType::Real);
+  return acc;
+}
+constexpr char kMax[] = "max";
+constexpr char kMin[] = "min";
+
+// The clocks are read when the program runs, not when it is compiled.
+Value P_real_time(Value *, int) {
+  return let(RCompute::RealTime, {}, RType::Real);
+}
+Value P_runtime(Value *, int) {
+  return let(RCompute::RunTime, {}, RType::Real);
+}
+
+// A parameter stays a run-time value: ./prog --param name=value sets it;
+// sicm build --fix name=value makes it that constant instead, so that terms
+// it zeroes fold away.
+Value P_parameter(Value *a, int) {
+  if (!is_symbol(a[0])) wrong_type(a[0], 1, "parameter");
+  if (!is_number(a[1])) wrong_type(a[1], 2, "parameter");
+  double fixed;
+  if (fixed_parameter(symbol_name(a[0]), &fixed)) return Value::flonum(fixed);
+  if (g_open.size() > 1)
+    cannot_compile(here(), "a parameter declared inside a procedure that runs at run time "
+                           "(declare it at top level)");
+  const std::string &name = symbol_name(a[0]);
+  std::vector<std::string> &names = g_prog->parameters;
+  if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  RStmt s{RKind::Let};
+  s.compute = RCompute::Param;
+  s.text = name;
+  s.args = {expr_from_number(a[1])};
+  Value v = new_var(RType::Real);
+  s.var = var_of(v);
+  emit(std::move(s));
+  return v;
+}
+
+Value P_not(Value *a, int n) {
+  if (is_dynamic_boolean(a[0])) return let(RCompute::Not, {expr_of(a[0], "not")}, RType::Boolean);
+  return call_original("not", a, n);
+}
+
+// A run-time value is a real number at run time: a flonum, or an exact
+// non-negative integer for a count (minimize's iterations).
+template <const char *Name> Value P_number_test(Value *a, int n) {
+  if (!is_dynamic_scalar(a[0])) return call_original(Name, a, n);
+  int v = var_of(a[0]);
+  bool count = v >= 0 && g_prog->vars[v].type == RType::Integer;
+  std::string_view name = Name;
+  if (name == "number?" || name == "real?") return Value::boolean(true);
+  if (name == "inexact?") return Value::boolean(!count);
+  return Value::boolean(count); // exact?, integer?, exact-integer?, ...
+}
+constexpr char kNumberP[] = "number?";
+constexpr char kRealP[] = "real?";
+constexpr char kInexactP[] = "inexact?";
+constexpr char kExactP[] = "exact?";
+constexpr char kIntegerP[] = "integer?";
+constexpr char kExactIntegerP[] = "exact-integer?";
+constexpr char kExactNonnegP[] = "exact-nonnegative-integer?";
+constexpr char kExactRationalP[] = "exact-rational?";
+
+template <const char *Name> Value P_identity_on_dynamic(Value *a, int n) {
+  if (is_dynamic_scalar(a[0])) return a[0];
+  return call_original(Name, a, n);
+}
+constexpr char kExactToInexact[] = "exact->inexact";
+constexpr char kInexact[] = "inexact";
+
+const DynamicBranchHooks kHooks = {hook_dynamic_test,   hook_branch,    hook_logic,
+                                   hook_set_global,     hook_set_local, hook_call_closure,
+                                   hook_apply_to_other, hook_forcing};
+
+Value prepare_toplevel(Value v) {
+  return prepare_for_print(v);
+}
+
+} // namespace
+
+Value call_original(const char *name, Value *a, int n) {
+  return original(name)(a, n);
+}
+
+namespace {
+
+// What each rebound name held before (a primitive, or unbound), for end_build_mode.
+std::vector<Symbol *> g_rebound;
+gcvec<Value> g_rebound_values; // scanned: the primitives' objects stay alive
+std::vector<bool> g_rebound_bound;
+
+} // namespace
+
+void rebind(const char *name, int min, int max, PrimFn fn) {
+  Symbol *s = intern(name).symbol();
+  if (s->bound && s->global.is(Tag::Primitive)) g_original[name] = s->global.as<Primitive>()->fn;
+  g_rebound.push_back(s);
+  g_rebound_values.push_back(s->global);
+  g_rebound_bound.push_back(s->bound);
+  define_primitive(name, min, max, fn);
+}
+
+} // namespace sicm::build
+
+namespace sicm {
+
+bool in_build_mode() {
+  return build::g_prog != nullptr;
+}
+
+void begin_build_mode(ResidualProgram *program) {
+  using namespace build;
+  // Divisions by matrices of run-time values outside kernels compute as
+  // the interpreter does (algebra/linear_solve.hpp).
+  set_run_time_value_test(is_dynamic_scalar);
+  g_blocks = {nullptr};
+  g_bottom = Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kBottomKind, nullptr}));
+  g_prog = program;
+  RFunction main_fn;
+  main_fn.id = 0;
+  main_fn.parent = -1;
+  main_fn.name = "main";
+  program->functions.push_back(std::move(main_fn));
+  g_open = {0};
+  g_advancer_lambda.name = intern("state-advancer").symbol();
+  g_evolver_lambda.name = intern("evolve").symbol();
+
+  rebind("display", 1, 2, P_print<kDisplay>);
+  rebind("write", 1, 2, P_print<kWrite>);
+  rebind("write-line", 1, 2, P_print<kWriteLine>);
+  rebind("pp", 1, 2, P_print<kPp>);
+  rebind("print-expression", 1, 1, P_print<kPrintExpression>);
+  rebind("pe", 1, 1, P_print<kPe>);
+  rebind("<", 1, kVariadic, P_compare<kLess, RCompute::Less, false>);
+  rebind(">", 1, kVariadic, P_compare<kGreater, RCompute::Less, true>);
+  rebind("<=", 1, kVariadic, P_compare<kLessEq, RCompute::LessEq, false>);
+  rebind(">=", 1, kVariadic, P_compare<kGreaterEq, RCompute::LessEq, true>);
+  rebind("=", 1, kVariadic, P_compare<kEqual, RCompute::Equal, false>);
+  rebind("zero?", 1, 1, P_sign_test<kZero, RCompute::Equal, false>);
+  rebind("positive?", 1, 1, P_sign_test<kPositive, RCompute::Less, true>);
+  rebind("negative?", 1, 1, P_sign_test<kNegative, RCompute::Less, false>);
+  rebind("floor", 1, 1, P_unary<kFloor, RCompute::Floor>);
+  rebind("round", 1, 1, P_unary<kRound, RCompute::Round>);
+  rebind("truncate", 1, 1, P_unary<kTruncate, RCompute::Truncate>);
+  rebind("max", 1, kVariadic, P_fold<kMax, RCompute::Max>);
+  rebind("min", 1, kVariadic, P_fold<kMin, RCompute::Min>);
+  rebind("not", 1, 1, P_not);
+  rebind("eq?", 2, 2, P_same<kEqP, false>);
+  rebind("eqv?", 2, 2, P_same<kEqvP, false>);
+  rebind("equal?", 2, 2, P_same<kEqualP, true>);
+  rebind("real-time", 0, 0, P_real_time);
+  rebind("parameter", 2, 2, P_parameter);
+  rebind("runtime", 0, 0, P_runtime);
+  rebind("number?", 1, 1, P_number_test<kNumberP>);
+  rebind("real?", 1, 1, P_number_test<kRealP>);
+  rebind("inexact?", 1, 1, P_number_test<kInexactP>);
+  rebind("exact?", 1, 1, P_number_test<kExactP>);
+  rebind("integer?", 1, 1, P_number_test<kIntegerP>);
+  rebind("exact-integer?", 1, 1, P_number_test<kExactIntegerP>);
+  rebind("exact-nonnegative-integer?", 1, 1, P_number_test<kExactNonnegP>);
+  rebind("exact-rational?", 1, 1, P_number_test<kExactRationalP>);
+  rebind("exact->inexact", 1, 1, P_identity_on_dynamic<kExactToInexact>);
+  rebind("inexact", 1, 1, P_identity_on_dynamic<kInexact>);
+
+  rebind_numerical_primitives();
+  rebind_plot_primitives();
+
+  rebind_list_primitives();
+  rebind_parallel_primitives();
+  rebind_mutators();
+
+  set_output_hook(residual_output);
+  set_capture_hook(hook_capture);
+  set_print_preparer(prepare_toplevel);
+  g_dynamic_branch_hooks = &kHooks;
+}
+
+void end_build_mode() {
+  using namespace build;
+  for (size_t i = g_rebound.size(); i-- > 0;) { // the first rebinding of a name holds the original
+    g_rebound[i]->global = g_rebound_values[i];
+    g_rebound[i]->bound = g_rebound_bound[i];
+  }
+  g_rebound.clear();
+  g_rebound_values.clear();
+  g_rebound_bound.clear();
+  g_original.clear();
+  g_dynamic_branch_hooks = nullptr;
+  set_output_hook(nullptr);
+  set_capture_hook(nullptr);
+  set_print_preparer(nullptr);
+  set_run_time_value_test(nullptr);
+  g_prog = nullptr;
+  g_open.clear();
+  g_var_of.clear();
+  g_branch_depth = 0;
+  g_blocks.clear();
+  g_work = 0;
+  g_cell_initialized.clear();
+  g_cell_frames.clear();
+  g_function_serials.clear();
+  reset_branches();
+  reset_lists();
+  reset_loops();
+}
+
+} // namespace sicm

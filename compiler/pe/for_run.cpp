@@ -1,0 +1,199 @@
+// sicm run's compiled procedures: a procedure of one real (bisect's
+// function) compiled by sicm build's partial evaluator into a C function, as
+// a built program compiles it, and loaded into the running process.
+//
+// Why: the function the book gives bisect in section 4.6.1 (which-way?)
+// iterates a map thousands of times per call, in a loop whose exit depends
+// on the argument. The kernel tracer (codegen/trace.cpp) compiles only
+// straight-line arithmetic, and the interpreter takes minutes where the
+// built program takes seconds.
+//
+// How: build mode is switched on for the trace alone (begin_build_mode ...
+// end_build_mode) with a residual program of its own; the procedure is
+// traced into one function exactly as sicm build traces bisect's function
+// (trace_scalar); the function is written as a C unit that needs no runtime
+// (emit_residual_function) and loaded by the JIT.
+//
+// The trace runs the procedure once, at compile time, in the interpreter's
+// own heap, so nothing it does may outlive it, and nothing the procedure
+// does at each call may be done only once. While tracing for run, these are
+// refused ("cannot compile") before they happen: set! of a variable made
+// before the trace began, mutating a pair, vector or string or forcing a
+// promise made before it (as sicm build refuses them: pe/branches.cpp),
+// output, random numbers and the clock. After the trace,
+// a function that does anything but arithmetic, tests and loops (calls a
+// numerical primitive, plots, builds a list of run-time length) is refused.
+// A refusal ends the attempt with the heap as it was, and the caller goes on
+// interpreting: compiling is never required, and never changes what a
+// program prints except in the last digits a different order of floating
+// point operations can change (as between sicm run and sicm build).
+#include <cstring>
+#include <string>
+
+#include "base/limits.hpp"
+#include "codegen/jit.hpp"
+#include "codegen/residual_emit.hpp"
+#include "eval/core.hpp"
+#include "eval/procedure.hpp"
+#include "pe/build.hpp"
+#include "pe/state.hpp"
+
+namespace sicm {
+
+namespace build {
+namespace {
+
+const char kEntry[] = "sicm_run_entry";
+
+uint32_t g_trace_serial = 0; // g_frame_serial when the trace began
+
+[[noreturn]] void refuse(SrcLoc loc, const std::string &what) {
+  cannot_compile(loc, what + " in a procedure compiled for sicm run");
+}
+
+Value for_run_set_global(Symbol *s, Value, SrcLoc loc) {
+  refuse(loc, "set! of the global variable " + s->name);
+}
+
+Value for_run_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc) {
+  if (!made_since(f->serial, g_trace_serial))
+    refuse(loc, "set! of a variable made before the call");
+  return hook_set_local(f, index, v, loc);
+}
+
+void for_run_output(std::string_view) {
+  refuse(here(), "output");
+}
+
+Value P_effect(Value *, int) {
+  refuse(here(), "an effect (a mutation, output, random numbers or the clock)");
+}
+
+// The primitives whose effect would happen once, at compile time, instead
+// of at each call. (Mutations of what the procedure did not make, and
+// forcing promises it did not make, sicm build refuses too: pe/branches.cpp.)
+const char *const kEffects[] = {
+    "random",       "runtime",          "real-time",  "exit",
+    "%exit",        "newline",          "fresh-line", "write-char",
+    "write-string", "display",          "write",      "write-line",
+    "pp",           "print-expression", "pe",         "with-output-to-string",
+};
+
+const DynamicBranchHooks kForRunHooks = {hook_dynamic_test,   hook_branch,       hook_logic,
+                                         for_run_set_global,  for_run_set_local, hook_call_closure,
+                                         hook_apply_to_other, hook_forcing};
+
+// Build mode for one trace: on while it lives, off (the heap's primitives
+// and hooks as they were) when it goes, however the trace ends.
+class TraceForRun {
+public:
+  explicit TraceForRun(ResidualProgram *program) {
+    begin_build_mode(program);
+    for (const char *name : kEffects)
+      rebind(name, 0, kVariadic, P_effect);
+    g_dynamic_branch_hooks = &kForRunHooks;
+    set_output_hook(for_run_output);
+    g_trace_serial = g_frame_serial;
+  }
+  ~TraceForRun() { end_build_mode(); }
+  TraceForRun(const TraceForRun &) = delete;
+  TraceForRun &operator=(const TraceForRun &) = delete;
+};
+
+// Statements a loaded function may hold: arithmetic, tests and loops.
+bool only_arithmetic(const std::vector<RStmt> &body) {
+  for (const RStmt &s : body) {
+    switch (s.kind) {
+    case RKind::Let:
+      switch (s.compute) {
+      case RCompute::Expr:
+      case RCompute::Less:
+      case RCompute::LessEq:
+      case RCompute::Equal:
+      case RCompute::Select:
+      case RCompute::Not:
+      case RCompute::Floor:
+      case RCompute::Round:
+      case RCompute::Truncate:
+      case RCompute::Max:
+      case RCompute::Min: break;
+      default: return false;
+      }
+      break;
+    case RKind::If:
+    case RKind::Loop:
+    case RKind::Continue:
+    case RKind::Break: break;
+    default: return false;
+    }
+    if (!only_arithmetic(s.then_body) || !only_arithmetic(s.else_body)) return false;
+  }
+  return true;
+}
+
+// Does the C call anything named sicm_ that its own prelude does not define?
+bool calls_runtime(const std::string &c) {
+  static const char *const kOwn[] = {
+      "sicm_site",  "sicm_escape", "sicm_checked_", "sicm_singular_nan",
+      "sicm_ldlt_", "sicm_lu_",    kEntry};
+  for (size_t at = c.find("sicm_"); at != std::string::npos; at = c.find("sicm_", at + 1)) {
+    bool own = false;
+    for (const char *name : kOwn)
+      own = own || c.compare(at, std::strlen(name), name) == 0;
+    if (!own) return true;
+  }
+  return false;
+}
+
+} // namespace
+} // namespace build
+
+CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not) {
+  using namespace build;
+  if (in_build_mode()) {
+    *why_not = "sicm build compiles it with the program";
+    return nullptr;
+  }
+  if (current_limits().max_steps != kUnlimited) {
+    *why_not = "--max-steps counts the interpreter's steps";
+    return nullptr;
+  }
+  ResidualProgram program;
+  program.source_name = procedure_name(f);
+  int id = -1;
+  const SrcLoc call = current_call_loc(); // the trace moves it into the procedure
+  try {
+    TraceForRun build(&program);
+    id = trace_scalar(f, who);
+  } catch (const Error &e) {
+    reset_call_loc(call);
+    if (std::string_view(e.what()) == "Interrupted") throw;
+    *why_not = e.what();
+    return nullptr;
+  } catch (...) { // an escape from the procedure: it will escape when interpreted, too
+    reset_call_loc(call);
+    *why_not = "the procedure escapes";
+    return nullptr;
+  }
+  reset_call_loc(call);
+  if (program.functions.size() != 2 || !program.functions[0].body.empty() ||
+      !program.cells.empty() || !program.lists.empty() || program.plots != 0 ||
+      !only_arithmetic(program.functions[id].body)) {
+    *why_not = "it does more than arithmetic, tests and loops";
+    return nullptr;
+  }
+  std::string c;
+  try {
+    c = emit_residual_function(program, id, kEntry);
+  } catch (const Error &e) {
+    *why_not = e.what();
+    return nullptr;
+  }
+  if (calls_runtime(c)) {
+    *why_not = "it needs the runtime";
+    return nullptr;
+  }
+  return reinterpret_cast<CompiledScalarFn>(jit_load(c, kEntry, nullptr, why_not));
+}
+
+} // namespace sicm

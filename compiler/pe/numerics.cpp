@@ -1,0 +1,571 @@
+// `sicm build`'s numerical primitives: definite-integral, minimize,
+// multidimensional-minimize, find-root, bisect, state-advancer and evolve
+// record a statement of the residual program and return fresh run-time
+// values. The procedures they are given (an integrand, an objective, a
+// system derivative, a monitor) are traced into functions of the residual
+// program, which the statement calls. Part of build mode (the design is in
+// pe/build_mode.cpp; the shared declarations in pe/state.hpp).
+#include <cmath>
+#include <string>
+#include <unordered_map>
+
+#include "algebra/generic.hpp"
+#include "algebra/linear_solve.hpp"
+#include "base/limits.hpp"
+#include "base/number.hpp"
+#include "builtins/numerics_defaults.hpp"
+#include "codegen/emit_taylor.hpp"
+#include "codegen/kernel_form.hpp"
+#include "codegen/singular_factors.hpp"
+#include "codegen/state_shape.hpp"
+#include "codegen/trace.hpp"
+#include "eval/primitive.hpp"
+#include "eval/procedure.hpp"
+#include "pe/state.hpp"
+#include "print/printer.hpp"
+
+namespace sicm::build {
+
+namespace {
+
+// ---- tracing procedures into functions ------------------------------------------------
+
+// Opens a function for the duration of a trace.
+class FunctionScope {
+public:
+  FunctionScope(const std::string &name) {
+    RFunction f;
+    f.id = static_cast<int>(g_prog->functions.size());
+    f.parent = g_open.back();
+    f.name = name;
+    f.loc = here();
+    g_prog->functions.push_back(std::move(f));
+    g_open.push_back(g_prog->functions.back().id);
+    g_blocks.push_back(nullptr);
+    g_function_serials.push_back(g_frame_serial);
+    saved_depth_ = g_branch_depth;
+    g_branch_depth = 0; // a test inside the traced procedure is its own
+    for (const RCell &c : g_prog->cells)
+      saved_.push_back(*c.place);
+    for (Value *place : list_cell_places())
+      saved_lists_.push_back(place ? *place : Value::nil());
+    read_cells();
+  }
+  ~FunctionScope() {
+    g_open.pop_back();
+    g_blocks.pop_back();
+    g_function_serials.pop_back();
+    g_branch_depth = saved_depth_;
+    for (size_t i = 0; i < saved_.size() && i < g_prog->cells.size(); ++i)
+      *g_prog->cells[i].place = saved_[i];
+    std::vector<Value *> places = list_cell_places();
+    for (size_t i = 0; i < saved_lists_.size() && i < places.size(); ++i)
+      *places[i] = saved_lists_[i];
+  }
+  int id() const { return g_open.back(); }
+
+private:
+  int saved_depth_;
+  gcvec<Value> saved_;       // the cells' globals as the caller sees them
+  gcvec<Value> saved_lists_; // the list cells' variables
+};
+
+} // namespace
+
+// A value shaped like `sample` (a number, or an up/down structure of them)
+// whose leaves are fresh inputs of the current function.
+Value input_like(Value sample) {
+  gcvec<Value> leaves;
+  state_leaves(sample, leaves);
+  for (Value &leaf : leaves) {
+    leaf = new_var(RType::Real);
+    current().inputs.push_back(var_of(leaf));
+  }
+  return state_from_leaves(sample, leaves);
+}
+
+bool is_state_shape(Value v) {
+  if (is_number(v) || is_dynamic_scalar(v)) return true;
+  size_t len;
+  Value *items = container_items(v, &len);
+  if (!items || len == 0) return false;
+  for (size_t i = 0; i < len; ++i)
+    if (!is_state_shape(items[i])) return false;
+  return true;
+}
+
+std::string procedure_name(Value proc) {
+  if (proc.is(Tag::Closure) && proc.as<Closure>()->lambda->name)
+    return proc.as<Closure>()->lambda->name->name;
+  return "anonymous";
+}
+
+int in_new_function(const std::string &name, const std::function<void()> &body) {
+  FunctionScope scope(name);
+  body();
+  return scope.id();
+}
+
+namespace {
+
+// The result leaves of a traced procedure as outputs, unsimplified: they
+// keep the order of operations the interpreter follows (so a built program
+// computes what `sicm run` computes), and expanding, say, (x - 2)^2 into
+// x^2 - 4x + 4 would lose the accuracy a minimizer near 2 needs.
+void set_outputs(Value result, const char *who) {
+  gcvec<Value> leaves;
+  if (!is_state_shape(result))
+    cannot_compile(here(), std::string("the procedure passed to ") + who + " returns " +
+                               describe(result) + ", not a number or a structure of numbers");
+  state_leaves(result, leaves);
+  for (Value leaf : leaves)
+    current().outputs.push_back(expr_of(leaf, who));
+}
+
+} // namespace
+
+int trace_scalar(Value f, const char *who) {
+  if (!is_procedure(f)) wrong_type(f, 1, who);
+  FunctionScope scope(procedure_name(f));
+  Value x = input_like(Value::flonum(0));
+  Value r = apply_procedure(f, &x, 1);
+  if (!is_number(r) && !is_dynamic_scalar(r))
+    cannot_compile(here(), std::string("the procedure passed to ") + who + " returns " +
+                               describe(r) + ", not a number");
+  set_outputs(r, who);
+  return scope.id();
+}
+
+namespace {
+
+// ---- numerical primitives ---------------------------------------------------------------
+
+// A numerical primitive run by with_retrace.
+template <PrimFn F> Value retrying(Value *a, int n) {
+  return with_retrace([&] { return F(a, n); });
+}
+
+template <NativeFn F> Value retrying_native(NativeProc *self, Value *a, int n) {
+  return with_retrace([&] { return F(self, a, n); });
+}
+
+double static_number(Value *a, int n, int i, double fallback, const char *who) {
+  if (i >= n || a[i].is(Tag::Default)) return fallback;
+  if (!is_number(a[i])) {
+    if (is_dynamic_scalar(a[i]))
+      cannot_compile(here(), std::string(who) + "'s tolerance must be known at compile time");
+    wrong_type(a[i], i + 1, who);
+  }
+  return to_double(a[i]);
+}
+
+ExprId limit_expr(Value v, const char *who) {
+  if (is_symbol(v) && var_of(v) < 0) {
+    const std::string &s = symbol_name(v);
+    if (s == ":+infinity" || s == "+infinity") return expr_flonum(INFINITY);
+    if (s == ":-infinity" || s == "-infinity") return expr_flonum(-INFINITY);
+  }
+  return expr_of(v, who);
+}
+
+Value P_definite_integral(Value *a, int n) {
+  static const char who[] = "definite-integral";
+  if (is_number(a[1]) && is_number(a[2]) && to_double(a[1]) == to_double(a[2]))
+    return Value::fixnum(0); // as the interpreter: an exact 0 over an empty interval
+  RStmt s{RKind::Integral};
+  s.loc = here();
+  s.args = {limit_expr(a[1], who), limit_expr(a[2], who)};
+  s.number = static_number(a, n, 3, kIntegralTolerance, who);
+  s.callee = trace_scalar(a[0], who);
+  Value r = new_var(RType::Real);
+  s.outs = {var_of(r)};
+  emit(std::move(s));
+  return r;
+}
+
+template <const char *Name> Value P_minimize(Value *a, int n) {
+  RStmt s{RKind::Minimize};
+  s.loc = here();
+  s.args = {expr_of(a[1], Name), expr_of(a[2], Name)};
+  s.number = static_number(a, n, 3, kMinimizeTolerance, Name);
+  s.callee = trace_scalar(a[0], Name);
+  Value x = new_var(RType::Real), fx = new_var(RType::Real), it = new_var(RType::Integer);
+  s.outs = {var_of(x), var_of(fx), var_of(it)};
+  emit(std::move(s));
+  return list({x, fx, it});
+}
+constexpr char kMinimize[] = "minimize";
+constexpr char kBrentMin[] = "brent-min";
+
+Value P_multidimensional_minimize(Value *a, int n) {
+  static const char who[] = "multidimensional-minimize";
+  if (!is_procedure(a[0])) wrong_type(a[0], 1, who);
+  bool is_list = !a[1].is(Tag::Vector);
+  gcvec<Value> start;
+  if (is_list) {
+    if (list_length(a[1]) <= 0) wrong_type(a[1], 2, who);
+    start = list_to_vector(a[1]);
+  } else {
+    Vector *v = a[1].vector();
+    start.assign(v->items, v->items + v->len);
+  }
+  if (start.empty()) wrong_type(a[1], 2, who);
+  RStmt s{RKind::Multimin};
+  s.loc = here();
+  for (Value x : start)
+    s.args.push_back(expr_of(x, who));
+  s.number = static_number(a, n, 2, kNelderTolerance, who);
+  {
+    FunctionScope scope(procedure_name(a[0]));
+    gcvec<Value> xs;
+    for (size_t i = 0; i < start.size(); ++i)
+      xs.push_back(input_like(Value::flonum(0)));
+    Value point;
+    if (is_list) {
+      point = list_from(xs.data(), xs.size());
+    } else {
+      point = make_vector(xs.size(), Value::fixnum(0));
+      for (size_t i = 0; i < xs.size(); ++i)
+        point.vector()->items[i] = xs[i];
+    }
+    Value r = apply_procedure(a[0], &point, 1);
+    set_outputs(r, who);
+    if (current().outputs.size() != 1)
+      cannot_compile(here(), "the function passed to multidimensional-minimize must return one "
+                             "number");
+    s.callee = scope.id();
+  }
+  gcvec<Value> result;
+  for (size_t i = 0; i < start.size(); ++i) {
+    Value x = new_var(RType::Real);
+    s.outs.push_back(var_of(x));
+    result.push_back(x);
+  }
+  emit(std::move(s));
+  if (is_list) return list_from(result.data(), result.size());
+  Value v = make_vector(result.size(), Value::fixnum(0));
+  for (size_t i = 0; i < result.size(); ++i)
+    v.vector()->items[i] = result[i];
+  return v;
+}
+
+Value P_find_root(Value *a, int n) {
+  static const char who[] = "find-root";
+  RStmt s{RKind::FindRoot};
+  s.loc = here();
+  s.args = {expr_of(a[1], who), expr_of(a[2], who)};
+  s.number = static_number(a, n, 3, 0.0, who);
+  s.callee = trace_scalar(a[0], who);
+  Value r = new_var(RType::Real);
+  s.outs = {var_of(r)};
+  emit(std::move(s));
+  return r;
+}
+
+Value bisect_at_run_time(Value *a, int n) {
+  static const char who[] = "bisect";
+  RStmt s{RKind::Bisect};
+  s.loc = here();
+  s.args = {expr_of(a[1], who), expr_of(a[2], who), expr_of(a[3], who)};
+  s.number = static_number(a, n, 4, kBisectBreak, who);
+  s.callee = trace_scalar(a[0], who);
+  Value r = new_var(RType::Real);
+  s.outs = {var_of(r)};
+  emit(std::move(s));
+  return r;
+}
+
+// A numerical primitive whose result cannot be left for run time, computed
+// while compiling by the interpreter's `name`, as sicm run computes it: the
+// program keeps the number, and an error of the program is raised as sicm
+// run raises it. Where the function reads values known only at run time it
+// cannot be computed now either; what the program added is rewound and
+// `why_not` says so.
+Value computed_while_compiling(const char *name, Value *a, int n,
+                               const std::function<void()> &why_not) {
+  ProgramMark mark = mark_program();
+  try {
+    return call_original(name, a, n);
+  } catch (const Error &e) {
+    if (!is_cannot_compile(e)) throw;
+    rewind_program(mark);
+  }
+  why_not();
+  SICM_ASSERT(false); // why_not throws
+  return Value::unspecified();
+}
+
+// bisect with a function that cannot be compiled (it builds streams, or
+// lists that it mutates, as the book's which-way? of section 4.6.1 does) but
+// with every number known now is computed while compiling.
+Value P_bisect(Value *a, int n) {
+  bool known = is_number(a[1]) && is_number(a[2]) && is_number(a[3]) &&
+               (n < 5 || a[4].is(Tag::Default) || is_number(a[4]));
+  ProgramMark mark = mark_program();
+  const SrcLoc call = current_call_loc(); // the trace moves it into the function
+  try {
+    return bisect_at_run_time(a, n);
+  } catch (const Error &e) {
+    if (!known || !is_cannot_compile(e)) throw;
+    rewind_program(mark);
+    reset_call_loc(call);
+    Error why = e;
+    return computed_while_compiling("bisect", a, n, [&] { throw why; });
+  }
+}
+
+// nelder-mead is not compiled for run time: it is computed while compiling.
+Value P_nelder_mead(Value *a, int n) {
+  return computed_while_compiling("nelder-mead", a, n, [] {
+    cannot_compile(here(), "nelder-mead is not compiled for run time, and its function reads "
+                           "values known only at run time");
+  });
+}
+
+// The integrator of argument i (or *ode-integration-method*) as the
+// runtime's step type variable.
+std::string method_of(Value *a, int n, int i, const char *who) {
+  Value m =
+      i < n && !a[i].is(Tag::Default) ? a[i] : intern("*ode-integration-method*").symbol()->global;
+  const char *c = is_symbol(m) ? integrator_c_name(symbol_name(m)) : nullptr;
+  if (!c) {
+    std::string why = is_symbol(m) ? integrator_not_provided(symbol_name(m)) : "";
+    if (!why.empty()) runtime_error(here(), std::string(who) + ": " + why);
+    if (i < n) bad_range(a[i], i + 1, who);
+    runtime_error(here(), std::string(who) + ": *ode-integration-method* is " + write_string(m) +
+                              ", which names no integrator");
+  }
+  return c;
+}
+
+bool is_scalar_leaf(Value v) {
+  return is_number(v) || is_dynamic_scalar(v);
+}
+
+// May a residual function hold this node? A symbol only if it is a
+// run-time value, a call only if it is a linear solve.
+bool run_time_node(ExprId id) {
+  const ExprNode &n = expr_node(id);
+  if (n.kind == ExprKind::Symbol) return g_var_of.count(n.sym) > 0;
+  return n.kind != ExprKind::Call || is_solve_node(id);
+}
+
+// A system derivative's leaves as the outputs of its kernel, in the form
+// sicm run's kernels take (codegen/kernel_form.hpp), so that both compute
+// the same numbers.
+std::vector<ExprId> system_outputs(const gcvec<Value> &leaves, const char *who) {
+  for (Value leaf : leaves)
+    if (leaf_expr(leaf) == kNoExpr) expr_of(leaf, who); // raises: not a number
+  std::vector<ExprId> outputs = kernel_outputs(leaves, run_time_node);
+  std::vector<bool> allowed = allowed_roots(outputs, run_time_node);
+  for (size_t i = 0; i < outputs.size(); ++i)
+    if (!allowed[i])
+      cannot_compile(here(), std::string(who) + " needs a number here, not " + describe(leaves[i]));
+  return outputs;
+}
+
+// Trace a system derivative on a state shaped like `state`; fills the
+// statement's callee, time_first and rate_one. The derivative takes the
+// form the interpreter's compiled derivatives take (kernel_outputs: evolve
+// in `sicm run` compiles the same kernel, so both compute the same numbers).
+void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
+  if (!is_state_shape(state)) wrong_type(state, 1, who);
+  FunctionScope scope(procedure_name(sysder));
+  gcvec<Value> x{input_like(state)};
+  Value d = apply_traced(sysder, x); // as sicm run traces its kernels
+  gcvec<Value> leaves;
+  if (!derivative_leaves(d, state, leaves, is_scalar_leaf))
+    cannot_compile(here(), std::string("the system derivative passed to ") + who + " returns " +
+                               describe(d) + ", which is not shaped like the state " +
+                               describe(state));
+  std::vector<ExprId> outputs = system_outputs(leaves, who);
+  current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
+  s.callee = scope.id();
+  size_t len;
+  Value *items = container_items(state, &len);
+  s.time_first = items && !container_items(items[0], &len);
+  ExprId d0 = current().outputs[0];
+  s.rate_one =
+      expr_is_exact_one(d0) || (expr_kind(d0) == ExprKind::Flonum && expr_node(d0).d == 1.0);
+}
+
+// The taylor methods integrate with the Taylor coefficients of the
+// solution, which residual_emit generates from the traced derivative: it
+// must be one DAG of operations with recurrences, without statements (a
+// test of a run-time value, a cell read) in its body.
+void check_taylor(const RStmt &s, const char *who) {
+  if (s.method != "sicm_ode_step_taylor" && s.method != "sicm_ode_step_taylor_extended") return;
+  const char *method = s.method == "sicm_ode_step_taylor" ? "taylor" : "taylor-extended";
+  const RFunction &f = g_prog->functions[s.callee];
+  if (!f.body.empty())
+    cannot_compile(s.loc, std::string(who) + ": " + method +
+                              " needs a system derivative that is one expression of the state; "
+                              "this one tests or reads run-time values; choose another "
+                              "integrator");
+  Trace t;
+  for (int v : f.inputs)
+    t.inputs.push_back(g_prog->vars[v].sym);
+  t.outputs = f.outputs;
+  std::string why_not;
+  auto any_symbol = [](Symbol *) { return std::string("p[0]"); };
+  if (emit_taylor_function(t, "check", &why_not, TaylorPrecision::Double, any_symbol).empty())
+    cannot_compile(s.loc, std::string(who) + ": " + method +
+                              " needs a compiled system derivative whose operations all have "
+                              "Taylor recurrences; this one has " +
+                              why_not);
+}
+
+// What the system derivative divides by, as a function of its own inputs
+// (the same state's leaves), for the runtime to name where an integration
+// fails (codegen/singular_factors.hpp).
+void trace_singular_factors(Value state, RStmt &s) {
+  std::vector<Symbol *> from;
+  for (int v : g_prog->functions[s.callee].inputs)
+    from.push_back(g_prog->vars[v].sym);
+  std::vector<std::string> paths = state_leaf_paths(state, "state");
+  std::unordered_map<Symbol *, std::string> names;
+  for (size_t i = 0; i < from.size() && i < paths.size(); ++i)
+    names[from[i]] = paths[i];
+  SingularFactors factors = singular_factors(g_prog->functions[s.callee].outputs, [&](Symbol *sym) {
+    auto it = names.find(sym);
+    return it == names.end() ? std::string() : it->second;
+  });
+  if (factors.values.empty()) return;
+  FunctionScope scope("singular_factors");
+  input_like(state);
+  std::vector<Symbol *> to;
+  for (int v : current().inputs)
+    to.push_back(g_prog->vars[v].sym);
+  current().outputs = with_inputs(factors.values, from, to);
+  s.probe = scope.id();
+  s.probe_texts = std::move(factors.texts);
+}
+
+// For the implicit methods, the Jacobian (D sysder) traced as a function of
+// the state too (its leaves: d f_i / d y_j at j * dim + i), as sicm run
+// compiles it; left to finite differences when it cannot be traced.
+void trace_jacobian(Value sysder, Value state, RStmt &s) {
+  if (s.method != "sicm_ode_step_msbdf" && s.method != "sicm_ode_step_cvode_bdf") return;
+  Symbol *d = intern("D").symbol();
+  if (!d->bound) return;
+  size_t nfunctions = g_prog->functions.size(), nvars = g_prog->vars.size();
+  try {
+    FunctionScope scope("jacobian");
+    Value dsys = apply_procedure(d->global, &sysder, 1);
+    gcvec<Value> x{input_like(state)};
+    Value j = apply_traced(dsys, x);
+    gcvec<Value> leaves;
+    state_leaves(j, leaves);
+    size_t n = current().inputs.size();
+    if (leaves.size() != n * n) return;
+    std::vector<ExprId> outputs = system_outputs(leaves, "jacobian");
+    current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
+    s.jacobian = scope.id();
+  } catch (const Error &) {
+    for (size_t v = nvars; v < g_prog->vars.size(); ++v)
+      g_var_of.erase(g_prog->vars[v].sym);
+    g_prog->functions.resize(nfunctions);
+    g_prog->vars.resize(nvars);
+    s.jacobian = -1;
+  }
+}
+
+Value state_result(Value state, RStmt &s) {
+  gcvec<Value> leaves;
+  state_leaves(state, leaves);
+  for (Value &leaf : leaves) {
+    leaf = new_var(RType::Real);
+    s.outs.push_back(var_of(leaf));
+  }
+  return state_from_leaves(state, leaves);
+}
+
+void state_args(Value state, RStmt &s, const char *who) {
+  gcvec<Value> leaves;
+  state_leaves(state, leaves);
+  for (Value leaf : leaves)
+    s.args.push_back(expr_of(leaf, who));
+}
+
+Value make_named(NativeFn fn, Value sysder, Lambda *lambda) {
+  Value p = make_native_procedure(fn, 0, sysder, Value::nil());
+  static_cast<NativeProc *>(p.as<Opaque>()->obj)->print_as.lambda = lambda;
+  return p;
+}
+
+Value sysder_of(Value *a, int n, const char *who) {
+  if (n < 1 || !is_procedure(a[0])) wrong_type(n < 1 ? Value::nil() : a[0], 1, who);
+  return apply_procedure(a[0], a + 1, n - 1);
+}
+
+Value advance(NativeProc *self, Value *a, int n) {
+  static const char who[] = "state-advancer";
+  if (n < 2 || n > 4) native_arity_error(self, n, 2);
+  RStmt s{RKind::Advance};
+  s.loc = here();
+  s.number = static_number(a, n, 2, kAdvancerTolerance, who);
+  s.method = method_of(a, n, 3, who);
+  state_args(a[0], s, who);
+  s.args.push_back(expr_of(a[1], who));
+  trace_system(self->a, a[0], s, who);
+  check_taylor(s, who);
+  trace_singular_factors(a[0], s);
+  trace_jacobian(self->a, a[0], s);
+  Value r = state_result(a[0], s);
+  emit(std::move(s));
+  return r;
+}
+
+Value P_state_advancer(Value *a, int n) {
+  return make_named(retrying_native<advance>, sysder_of(a, n, "state-advancer"),
+                    &g_advancer_lambda);
+}
+
+Value run_evolve(NativeProc *self, Value *a, int n) {
+  static const char who[] = "evolve";
+  if (n < 4 || n > 6) native_arity_error(self, n, 4);
+  RStmt s{RKind::Evolve};
+  s.loc = here();
+  s.number = static_number(a, n, 4, kAdvancerTolerance, who);
+  s.method = method_of(a, n, 5, who);
+  state_args(a[0], s, who);
+  s.args.push_back(expr_of(a[2], who));
+  s.args.push_back(expr_of(a[3], who));
+  trace_system(self->a, a[0], s, who);
+  check_taylor(s, who);
+  trace_singular_factors(a[0], s);
+  trace_jacobian(self->a, a[0], s);
+  Value monitor = a[1];
+  if (!is_procedure(monitor)) wrong_type(monitor, 2, who);
+  {
+    FunctionScope scope(procedure_name(monitor));
+    Value x = input_like(a[0]);
+    apply_procedure(monitor, &x, 1);
+    s.monitor = scope.id();
+  }
+  Value r = state_result(a[0], s);
+  emit(std::move(s));
+  return r;
+}
+
+Value P_evolve(Value *a, int n) {
+  return make_named(retrying_native<run_evolve>, sysder_of(a, n, "evolve"), &g_evolver_lambda);
+}
+
+} // namespace
+
+Lambda g_advancer_lambda, g_evolver_lambda;
+
+void rebind_numerical_primitives() {
+  rebind("definite-integral", 3, 5, retrying<P_definite_integral>);
+  rebind("minimize", 3, 4, retrying<P_minimize<kMinimize>>);
+  rebind("brent-min", 3, 4, retrying<P_minimize<kBrentMin>>);
+  rebind("multidimensional-minimize", 2, 3, retrying<P_multidimensional_minimize>);
+  rebind("find-root", 3, 4, retrying<P_find_root>);
+  rebind("nelder-mead", 2, 5, P_nelder_mead);
+  rebind("bisect", 4, 5, retrying<P_bisect>);
+  rebind("state-advancer", 1, kVariadic, P_state_advancer);
+  rebind("evolve", 1, kVariadic, P_evolve);
+}
+
+} // namespace sicm::build
