@@ -117,9 +117,9 @@ int build_program(const BuildOptions &o) {
       std::printf("%s\n", dump_node(analyze_form(f.datum, f.loc, nullptr)).c_str());
     return 0;
   }
-  ResidualProgram program;
+  BuildSession build;
+  ResidualProgram &program = build.program();
   program.source_name = base_name(o.input);
-  begin_build_mode(&program);
   run_source(file);
   if (o.dump == "residual") {
     std::fputs(dump_residual(program).c_str(), stdout);

@@ -17,14 +17,13 @@
 
 namespace sicm::build {
 
-std::vector<gcvec<Assignment> *> g_undo; // logs hold Values: collected memory
 // g_frame_serial when each log began: a local variable of a frame made
 // later belongs to the alternative (or loop body) itself and is not logged.
-std::vector<uint32_t> g_undo_serials;
 
 // Add a to the innermost log, if its variable is older than the log.
 void log_assignment(const Assignment &a) {
-  if (!g_undo.empty() && a.serial <= g_undo_serials.back()) g_undo.back()->push_back(a);
+  if (!g_build->undo.empty() && a.serial <= g_build->undo_serials.back())
+    g_build->undo.back()->push_back(a);
 }
 
 // Does the block call a function or add to a list (after which cells and
@@ -37,20 +36,7 @@ bool block_calls(const std::vector<RStmt> &block) {
   return false;
 }
 
-namespace {
-
-long g_branch_evaluations = 0; // alternatives evaluated under tests on run-time values
-// g_open.size() when each with-output-to-string began, innermost last.
-std::vector<size_t> g_capture_depths;
-
-} // namespace
-
-void reset_branches() {
-  g_capture_depths.clear();
-  g_undo.clear();
-  g_undo_serials.clear();
-  g_branch_evaluations = 0;
-}
+namespace {} // namespace
 
 namespace {
 
@@ -93,21 +79,21 @@ Value select_values(Value test, Value a, Value b) {
 
 // Evaluate one alternative under a run-time test.
 Value speculate(const std::function<Value()> &alternative) {
-  if (g_branch_depth >= kMaxBranchDepth)
+  if (g_build->branch_depth >= kMaxBranchDepth)
     cannot_compile(here(), "a loop or recursion whose end depends on a value known only at run "
                            "time");
-  if (++g_branch_evaluations > kMaxBranchEvaluations)
+  if (++g_build->branch_evaluations > kMaxBranchEvaluations)
     cannot_compile(here(), "more than " + std::to_string(kMaxBranchEvaluations) +
                                " alternatives under tests on run-time values: the program "
                                "unfolds too much (a loop whose arguments change shape, such as "
                                "a list that grows, cannot become a C loop and is unfolded)");
-  ++g_branch_depth;
+  ++g_build->branch_depth;
   try {
     Value v = alternative();
-    --g_branch_depth;
+    --g_build->branch_depth;
     return v;
   } catch (...) {
-    --g_branch_depth;
+    --g_build->branch_depth;
     throw;
   }
 }
@@ -116,13 +102,13 @@ Value speculate(const std::function<Value()> &alternative) {
 // its assignments to globals (recorded in *log).
 Value alternative(std::vector<RStmt> &block, gcvec<Assignment> &log,
                   const std::function<Value()> &eval_it) {
-  g_blocks.push_back(&block);
-  g_undo.push_back(&log);
-  g_undo_serials.push_back(g_frame_serial);
+  g_build->blocks.push_back(&block);
+  g_build->undo.push_back(&log);
+  g_build->undo_serials.push_back(g_frame_serial);
   auto restore = [&] {
-    g_blocks.pop_back();
-    g_undo.pop_back();
-    g_undo_serials.pop_back();
+    g_build->blocks.pop_back();
+    g_build->undo.pop_back();
+    g_build->undo_serials.pop_back();
     for (auto a = log.rbegin(); a != log.rend(); ++a) {
       a->after = *a->place;
       *a->place = a->before;
@@ -148,7 +134,7 @@ Value branch(Value test, const std::function<Value()> &then_fn,
   Value a = alternative(then_block, then_log, then_fn);
   Value b = alternative(else_block, else_log, else_fn);
   bool calls = block_calls(then_block) || block_calls(else_block);
-  if (!g_undo.empty()) { // an enclosing alternative undoes what these did, too
+  if (!g_build->undo.empty()) { // an enclosing alternative undoes what these did, too
     for (const auto *log : {&then_log, &else_log})
       for (const Assignment &x : *log)
         log_assignment(Assignment{x.place, x.before, x.before, x.serial});
@@ -216,7 +202,7 @@ Value assign(Value *place, const std::string &name, Value v, SrcLoc loc, bool ou
     if (!is_scalar(v))
       cannot_compile(loc, "set! of " + name + " to " + describe(v) +
                               ": a procedure run at run time assigns it, so it must hold a number");
-    if (scalar_type(v) == RType::Real) g_prog->cells[cell].type = RType::Real;
+    if (scalar_type(v) == RType::Real) g_build->program.cells[cell].type = RType::Real;
     set_cell(cell, v);
     return v;
   }
@@ -229,12 +215,12 @@ Value assign(Value *place, const std::string &name, Value v, SrcLoc loc, bool ou
     if (!may_create)
       cannot_compile(loc,
                      "set! of " + name + " inside a procedure run by another run-time procedure");
-    g_prog->cells.push_back(RCell{place, name, scalar_type(*place)});
-    g_cell_initialized.push_back(false);
-    if (frame) g_cell_frames.push_back(frame);
+    g_build->program.cells.push_back(RCell{place, name, scalar_type(*place)});
+    g_build->cell_initialized.push_back(false);
+    if (frame) g_build->cell_frames.push_back(frame);
     throw Retrace{};
   }
-  RCell &c = g_prog->cells[cell];
+  RCell &c = g_build->program.cells[cell];
   RType t = scalar_type(v);
   if (t != c.type) {
     if (c.type == RType::Boolean || t == RType::Boolean)
@@ -269,15 +255,15 @@ Value hook_logic(Value test, Node *n, uint32_t from, bool is_and, Frame *env) {
 }
 
 Value hook_set_global(Symbol *s, Value v, SrcLoc loc) {
-  return assign(&s->global, "the global variable " + s->name, v, loc, g_open.size() > 1,
-                g_open.size() == 2, nullptr);
+  return assign(&s->global, "the global variable " + s->name, v, loc, g_build->open.size() > 1,
+                g_build->open.size() == 2, nullptr);
 }
 
 Value hook_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc) {
   // Frames made before the innermost traced procedure began belong to its
   // callers: state kept across run-time calls.
-  bool outer = g_open.size() > 1 && !made_since(f->serial, g_function_serials.back());
-  bool may_create = g_open.size() == 2;
+  bool outer = g_build->open.size() > 1 && !made_since(f->serial, g_build->function_serials.back());
+  bool may_create = g_build->open.size() == 2;
   return assign(&f->slots[index], "a local variable", v, loc, outer, may_create, f);
 }
 
@@ -301,8 +287,8 @@ namespace {
 // Refuse who's mutation of v if v (a pair of the list it starts, a vector,
 // a string) was made before the innermost traced procedure was called.
 void check_owned(Value v, const char *who) {
-  if (g_open.size() <= 1) return;
-  uint32_t start = g_function_serials.back();
+  if (g_build->open.size() <= 1) return;
+  uint32_t start = g_build->function_serials.back();
   if (v.is(Tag::Vector) && !made_since(v.vector()->serial, start)) refuse_outer(who, "a vector");
   if (v.is(Tag::String)) refuse_outer(who, "a string");
   for (long n = 0; is_pair(v) && n < 1000000; v = cdr(v), ++n)
@@ -331,13 +317,13 @@ constexpr char kStringSet[] = "string-set!";
 namespace {
 
 Value P_with_output_to_string(Value *a, int n) {
-  g_capture_depths.push_back(g_open.size());
+  g_build->capture_depths.push_back(g_build->open.size());
   try {
     Value v = call_original("with-output-to-string", a, n);
-    g_capture_depths.pop_back();
+    g_build->capture_depths.pop_back();
     return v;
   } catch (...) {
-    g_capture_depths.pop_back();
+    g_build->capture_depths.pop_back();
     throw;
   }
 }
@@ -347,15 +333,15 @@ Value P_with_output_to_string(Value *a, int n) {
 // Output of a traced procedure into a string that a with-output-to-string
 // outside it captures: the text would be captured once, while compiling.
 void hook_capture() {
-  if (!g_capture_depths.empty() && g_open.size() > g_capture_depths.back())
+  if (!g_build->capture_depths.empty() && g_build->open.size() > g_build->capture_depths.back())
     cannot_compile(here(), "output of a procedure traced for run time into the string of a "
                            "with-output-to-string outside it");
 }
 
 void hook_forcing(Value promise) {
-  if (g_open.size() <= 1) return;
+  if (g_build->open.size() <= 1) return;
   Frame *env = promise.as<Promise>()->env;
-  if (!env || !made_since(env->serial, g_function_serials.back()))
+  if (!env || !made_since(env->serial, g_build->function_serials.back()))
     refuse_outer("forcing", "a promise");
 }
 

@@ -9,18 +9,30 @@
 
 namespace sicm {
 
-// Rebind the primitives and install the evaluator's hooks so that what runs
-// from now on records into `program` (which must outlive the run). Call
-// after init_interpreter, before running the program.
-void begin_build_mode(ResidualProgram *program);
+namespace build {
+struct BuildState;
+}
 
-// Back to sicm run: the primitives and hooks as they were before
-// begin_build_mode, and the build's state empty. Run-time values made
-// during the build must not have reached anything that outlives it (see
+// A build in progress. While it lives, the primitives whose meaning changes
+// are rebound and the evaluator's hooks installed, so that what runs records
+// into its residual program; when it goes, the interpreter is sicm run's
+// again. One at a time; construct after init_interpreter. Run-time values
+// made during the build must not reach anything that outlives it (see
 // compile_for_run in pe/for_run.cpp, which ensures it).
-void end_build_mode();
+class BuildSession {
+public:
+  BuildSession();
+  ~BuildSession();
+  BuildSession(const BuildSession &) = delete;
+  BuildSession &operator=(const BuildSession &) = delete;
 
-// Is a build going on (between begin_build_mode and end_build_mode)?
+  ResidualProgram &program();
+
+private:
+  build::BuildState *state_; // in memory the collector scans (it holds Values)
+};
+
+// Is a build going on (a BuildSession alive)?
 bool in_build_mode();
 
 // A procedure of one real compiled for sicm run: writes f(in[0]) to out[0]

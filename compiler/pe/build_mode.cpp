@@ -76,16 +76,13 @@ const char kMarkerSuffix[] = "__";
 
 } // namespace
 
-ResidualProgram *g_prog = nullptr;
-std::vector<int> g_open;                    // functions being traced, innermost last
-std::unordered_map<Symbol *, int> g_var_of; // residual variable of a symbol
-int g_branch_depth = 0;
-
 [[noreturn]] void cannot_compile(SrcLoc loc, const std::string &what) {
   throw Error(ErrorKind::Syntax, loc, "cannot compile: " + what,
               "sicm build leaves only numerical work for run time; `sicm run` interprets this "
               "program");
 }
+
+BuildState *g_build = nullptr;
 
 SrcLoc here() {
   SrcLoc loc = current_call_loc();
@@ -93,17 +90,16 @@ SrcLoc here() {
 }
 
 RFunction &current() {
-  return g_prog->functions[g_open.back()];
+  return g_build->program.functions[g_build->open.back()];
 }
 
 // Where statements go: the innermost open function's body, or the block of
 // an alternative under a run-time test being evaluated (owned by
 // hook_branch's frame). Function bodies are found by index: the function
 // vector grows while they are open.
-std::vector<std::vector<RStmt> *> g_blocks; // null: the open function's body
 
 std::vector<RStmt> &current_block() {
-  std::vector<RStmt> *b = g_blocks.empty() ? nullptr : g_blocks.back();
+  std::vector<RStmt> *b = g_build->blocks.empty() ? nullptr : g_build->blocks.back();
   return b ? *b : current().body;
 }
 
@@ -120,7 +116,7 @@ const OpaqueKind kRtListKind = {"run-time-list", write_rtlist, nullptr};
 // Does the expression mention a residual variable? (Memoized: the arena
 // only grows and nodes never change.)
 bool expr_is_dynamic(ExprId root) {
-  static std::unordered_map<ExprId, bool> memo;
+  std::unordered_map<ExprId, bool> &memo = g_build->dynamic_memo;
   auto hit = memo.find(root);
   if (hit != memo.end()) return hit->second;
   bool dynamic = false;
@@ -128,7 +124,7 @@ bool expr_is_dynamic(ExprId root) {
   switch (n.kind) {
   case ExprKind::Rational:
   case ExprKind::Flonum: break;
-  case ExprKind::Symbol: dynamic = g_var_of.count(n.sym) > 0; break;
+  case ExprKind::Symbol: dynamic = g_build->var_ids.count(n.sym) > 0; break;
   case ExprKind::Apply:
   case ExprKind::Call: {
     std::vector<ExprId> args = expr_arg_vector(root);
@@ -153,8 +149,8 @@ RType expr_type(ExprId id) {
   case ExprKind::Rational: return expr_is_exact_integer(id) ? RType::Integer : RType::Real;
   case ExprKind::Flonum: return RType::Real;
   case ExprKind::Symbol: {
-    auto it = g_var_of.find(n.sym);
-    return it == g_var_of.end() ? RType::Real : g_prog->vars[it->second].type;
+    auto it = g_build->var_ids.find(n.sym);
+    return it == g_build->var_ids.end() ? RType::Real : g_build->program.vars[it->second].type;
   }
   case ExprKind::Apply:
     if (n.op == Op::Add || n.op == Op::Mul) {
@@ -171,17 +167,17 @@ RType expr_type(ExprId id) {
 } // namespace
 
 Value new_var(RType type) {
-  int id = static_cast<int>(g_prog->vars.size());
+  int id = static_cast<int>(g_build->program.vars.size());
   Value sym = make_uninterned_symbol(kMarkerPrefix + std::to_string(id) + kMarkerSuffix);
-  g_prog->vars.push_back(RVar{sym.symbol(), type, id, g_open.back()});
-  g_var_of[sym.symbol()] = id;
+  g_build->program.vars.push_back(RVar{sym.symbol(), type, id, g_build->open.back()});
+  g_build->var_ids[sym.symbol()] = id;
   return sym;
 }
 
 int var_of(Value v) {
   if (!v.is(Tag::Symbol)) return -1;
-  auto it = g_var_of.find(v.symbol());
-  return it == g_var_of.end() ? -1 : it->second;
+  auto it = g_build->var_ids.find(v.symbol());
+  return it == g_build->var_ids.end() ? -1 : it->second;
 }
 
 RtList *as_rtlist(Value v) {
@@ -201,7 +197,7 @@ bool is_dynamic_scalar(Value v) {
 
 bool is_dynamic_boolean(Value v) {
   int id = var_of(v);
-  return id >= 0 && g_prog->vars[id].type == RType::Boolean;
+  return id >= 0 && g_build->program.vars[id].type == RType::Boolean;
 }
 
 bool contains_dynamic(Value v) {
@@ -244,7 +240,7 @@ ExprId expr_of(Value v, const char *who) {
 RType scalar_type(Value v) {
   if (v.is(Tag::Bool)) return RType::Boolean;
   int id = var_of(v);
-  if (id >= 0) return g_prog->vars[id].type;
+  if (id >= 0) return g_build->program.vars[id].type;
   if (v.is(Tag::Fixnum) || v.is(Tag::Bignum)) return RType::Integer;
   if (v.is(Tag::Expr)) return expr_type(static_cast<ExprId>(v.i));
   return RType::Real;
@@ -255,8 +251,6 @@ bool is_scalar(Value v) {
 }
 
 // ---- statements ---------------------------------------------------------------------
-
-uint64_t g_work = 0; // statements recorded other than output text (see StaticWatch)
 
 void emit(RStmt s) {
   if (!s.loc.known()) s.loc = here();
@@ -270,7 +264,7 @@ void emit(RStmt s) {
   // call is not a loop (LoopAbort is caught by the loop attempt).
   if (!body.empty() && body.back().kind == RKind::Continue) throw_not_a_loop();
   note_residual_statement(s.loc); // --max-residual-size
-  if (s.kind != RKind::Text) ++g_work;
+  if (s.kind != RKind::Text) ++g_build->work;
   bool calls = s.callee >= 0 || s.monitor >= 0;
   body.push_back(std::move(s));
   if (calls) read_cells(); // the call may have assigned them
@@ -284,16 +278,11 @@ void emit(RStmt s) {
 // call that may have assigned them. Only numbers and truth values can live
 // in a cell.
 
-std::vector<bool> g_cell_initialized;
-
 int cell_of(Value *place) {
-  for (size_t i = 0; i < g_prog->cells.size(); ++i)
-    if (g_prog->cells[i].place == place) return static_cast<int>(i);
+  for (size_t i = 0; i < g_build->program.cells.size(); ++i)
+    if (g_build->program.cells[i].place == place) return static_cast<int>(i);
   return -1;
 }
-
-gcvec<Frame *> g_cell_frames; // keeps the frames of local cells alive (a scanned vector)
-std::vector<uint32_t> g_function_serials; // g_frame_serial when each open function began
 
 void set_cell(int cell, Value v) {
   RStmt s{RKind::SetCell};
@@ -305,35 +294,35 @@ void set_cell(int cell, Value v) {
 // Make every cell's global hold a fresh read of the cell in the current function.
 void read_cells() {
   read_list_cells();
-  for (size_t i = 0; i < g_prog->cells.size(); ++i) {
-    if (!g_cell_initialized[i]) continue;
+  for (size_t i = 0; i < g_build->program.cells.size(); ++i) {
+    if (!g_build->cell_initialized[i]) continue;
     RStmt s{RKind::Let};
     s.compute = RCompute::ReadCell;
     s.cell = static_cast<int>(i);
-    Value v = new_var(g_prog->cells[i].type);
+    Value v = new_var(g_build->program.cells[i].type);
     s.var = var_of(v);
     current_block().push_back(std::move(s));
-    *g_prog->cells[i].place = v;
+    *g_build->program.cells[i].place = v;
   }
 }
 
 // Run a numerical primitive, tracing it again whenever a traced procedure
 // turns a global into a cell (or widens a cell from counts to reals).
 ProgramMark mark_program() {
-  return {g_prog->functions.size(), g_prog->vars.size(), current().body.size()};
+  return {g_build->program.functions.size(), g_build->program.vars.size(), current().body.size()};
 }
 
 void rewind_program(const ProgramMark &mark) {
-  for (size_t v = mark.nvars; v < g_prog->vars.size(); ++v)
-    g_var_of.erase(g_prog->vars[v].sym);
-  g_prog->functions.resize(mark.nfunctions);
-  g_prog->vars.resize(mark.nvars);
+  for (size_t v = mark.nvars; v < g_build->program.vars.size(); ++v)
+    g_build->var_ids.erase(g_build->program.vars[v].sym);
+  g_build->program.functions.resize(mark.nfunctions);
+  g_build->program.vars.resize(mark.nvars);
   std::vector<RStmt> &body = current().body;
   body.erase(body.begin() + static_cast<long>(mark.nbody), body.end());
 }
 
 Value with_retrace(const std::function<Value()> &body) {
-  size_t depth = g_open.size();
+  size_t depth = g_build->open.size();
   if (depth != 1) return body(); // the outermost primitive retraces
   // The primitive's call site: tracing its procedures moves the evaluator's
   // idea of the current call into them, and a retrace must not take that
@@ -346,10 +335,10 @@ Value with_retrace(const std::function<Value()> &body) {
       return body();
     } catch (const Retrace &) {
       rewind_program(mark);
-      for (size_t i = 0; i < g_prog->cells.size(); ++i) {
-        if (g_cell_initialized[i]) continue;
-        g_cell_initialized[i] = true;
-        set_cell(static_cast<int>(i), *g_prog->cells[i].place);
+      for (size_t i = 0; i < g_build->program.cells.size(); ++i) {
+        if (g_build->cell_initialized[i]) continue;
+        g_build->cell_initialized[i] = true;
+        set_cell(static_cast<int>(i), *g_build->program.cells[i].place);
       }
       init_list_cells();
     }
@@ -448,10 +437,8 @@ Value prepare_for_print(Value v) {
 
 namespace {
 
-std::unordered_map<std::string, PrimFn> g_original;
-
 PrimFn original(const char *name) {
-  return g_original.at(name);
+  return g_build->original_fns.at(name);
 }
 
 // Printing primitives: prepare the value, then print it as always.
@@ -606,11 +593,11 @@ Value P_parameter(Value *a, int) {
   if (!is_number(a[1])) wrong_type(a[1], 2, "parameter");
   double fixed;
   if (fixed_parameter(symbol_name(a[0]), &fixed)) return Value::flonum(fixed);
-  if (g_open.size() > 1)
+  if (g_build->open.size() > 1)
     cannot_compile(here(), "a parameter declared inside a procedure that runs at run time "
                            "(declare it at top level)");
   const std::string &name = symbol_name(a[0]);
-  std::vector<std::string> &names = g_prog->parameters;
+  std::vector<std::string> &names = g_build->program.parameters;
   if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
   RStmt s{RKind::Let};
   s.compute = RCompute::Param;
@@ -632,7 +619,7 @@ Value P_not(Value *a, int n) {
 template <const char *Name> Value P_number_test(Value *a, int n) {
   if (!is_dynamic_scalar(a[0])) return call_original(Name, a, n);
   int v = var_of(a[0]);
-  bool count = v >= 0 && g_prog->vars[v].type == RType::Integer;
+  bool count = v >= 0 && g_build->program.vars[v].type == RType::Integer;
   std::string_view name = Name;
   if (name == "number?" || name == "real?") return Value::boolean(true);
   if (name == "inexact?") return Value::boolean(!count);
@@ -668,21 +655,13 @@ Value call_original(const char *name, Value *a, int n) {
   return original(name)(a, n);
 }
 
-namespace {
-
-// What each rebound name held before (a primitive, or unbound), for end_build_mode.
-std::vector<Symbol *> g_rebound;
-gcvec<Value> g_rebound_values; // scanned: the primitives' objects stay alive
-std::vector<bool> g_rebound_bound;
-
-} // namespace
-
 void rebind(const char *name, int min, int max, PrimFn fn) {
   Symbol *s = intern(name).symbol();
-  if (s->bound && s->global.is(Tag::Primitive)) g_original[name] = s->global.as<Primitive>()->fn;
-  g_rebound.push_back(s);
-  g_rebound_values.push_back(s->global);
-  g_rebound_bound.push_back(s->bound);
+  if (s->bound && s->global.is(Tag::Primitive))
+    g_build->original_fns[name] = s->global.as<Primitive>()->fn;
+  g_build->rebound.push_back(s);
+  g_build->rebound_values.push_back(s->global);
+  g_build->rebound_bound.push_back(s->bound);
   define_primitive(name, min, max, fn);
 }
 
@@ -691,25 +670,29 @@ void rebind(const char *name, int min, int max, PrimFn fn) {
 namespace sicm {
 
 bool in_build_mode() {
-  return build::g_prog != nullptr;
+  return build::g_build != nullptr;
 }
 
-void begin_build_mode(ResidualProgram *program) {
+namespace {
+
+// Rebind the primitives and install the evaluator's hooks so that what runs
+// from now on records into state's program.
+void begin_build_mode(build::BuildState *state) {
   using namespace build;
+  SICM_ASSERT(!g_build); // one build at a time
+  g_build = state;
   // Divisions by matrices of run-time values outside kernels compute as
   // the interpreter does (algebra/linear_solve.hpp).
   set_run_time_value_test(is_dynamic_scalar);
-  g_blocks = {nullptr};
-  g_bottom = Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kBottomKind, nullptr}));
-  g_prog = program;
+  g_build->bottom = Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kBottomKind, nullptr}));
   RFunction main_fn;
   main_fn.id = 0;
   main_fn.parent = -1;
   main_fn.name = "main";
-  program->functions.push_back(std::move(main_fn));
-  g_open = {0};
-  g_advancer_lambda.name = intern("state-advancer").symbol();
-  g_evolver_lambda.name = intern("evolve").symbol();
+  g_build->program.functions.push_back(std::move(main_fn));
+  g_build->open = {0};
+  g_build->advancer_lambda.name = intern("state-advancer").symbol();
+  g_build->evolver_lambda.name = intern("evolve").symbol();
 
   rebind("display", 1, 2, P_print<kDisplay>);
   rebind("write", 1, 2, P_print<kWrite>);
@@ -761,33 +744,39 @@ void begin_build_mode(ResidualProgram *program) {
   g_dynamic_branch_hooks = &kHooks;
 }
 
+// Back to sicm run: the primitives and hooks as they were before begin_build_mode.
 void end_build_mode() {
   using namespace build;
-  for (size_t i = g_rebound.size(); i-- > 0;) { // the first rebinding of a name holds the original
-    g_rebound[i]->global = g_rebound_values[i];
-    g_rebound[i]->bound = g_rebound_bound[i];
+  for (size_t i = g_build->rebound.size();
+       i-- > 0;) { // the first rebinding of a name holds the original
+    g_build->rebound[i]->global = g_build->rebound_values[i];
+    g_build->rebound[i]->bound = g_build->rebound_bound[i];
   }
-  g_rebound.clear();
-  g_rebound_values.clear();
-  g_rebound_bound.clear();
-  g_original.clear();
   g_dynamic_branch_hooks = nullptr;
   set_output_hook(nullptr);
   set_capture_hook(nullptr);
   set_print_preparer(nullptr);
   set_run_time_value_test(nullptr);
-  g_prog = nullptr;
-  g_open.clear();
-  g_var_of.clear();
-  g_branch_depth = 0;
-  g_blocks.clear();
-  g_work = 0;
-  g_cell_initialized.clear();
-  g_cell_frames.clear();
-  g_function_serials.clear();
-  reset_branches();
-  reset_lists();
-  reset_loops();
+  g_build = nullptr;
+}
+
+} // namespace
+
+BuildSession::BuildSession() {
+  void *memory = GC_MALLOC_UNCOLLECTABLE(sizeof(build::BuildState));
+  if (!memory) throw std::bad_alloc();
+  state_ = new (memory) build::BuildState();
+  begin_build_mode(state_);
+}
+
+BuildSession::~BuildSession() {
+  end_build_mode();
+  state_->~BuildState();
+  GC_FREE(state_);
+}
+
+ResidualProgram &BuildSession::program() {
+  return state_->program;
 }
 
 } // namespace sicm

@@ -45,8 +45,6 @@ namespace {
 
 const char kEntry[] = "sicm_run_entry";
 
-uint32_t g_trace_serial = 0; // g_frame_serial when the trace began
-
 [[noreturn]] void refuse(SrcLoc loc, const std::string &what) {
   cannot_compile(loc, what + " in a procedure compiled for sicm run");
 }
@@ -56,7 +54,7 @@ Value for_run_set_global(Symbol *s, Value, SrcLoc loc) {
 }
 
 Value for_run_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc) {
-  if (!made_since(f->serial, g_trace_serial))
+  if (!made_since(f->serial, g_build->trace_serial))
     refuse(loc, "set! of a variable made before the call");
   return hook_set_local(f, index, v, loc);
 }
@@ -87,17 +85,17 @@ const DynamicBranchHooks kForRunHooks = {hook_dynamic_test,   hook_branch,      
 // and hooks as they were) when it goes, however the trace ends.
 class TraceForRun {
 public:
-  explicit TraceForRun(ResidualProgram *program) {
-    begin_build_mode(program);
+  TraceForRun() {
     for (const char *name : kEffects)
       rebind(name, 0, kVariadic, P_effect);
     g_dynamic_branch_hooks = &kForRunHooks;
     set_output_hook(for_run_output);
-    g_trace_serial = g_frame_serial;
+    g_build->trace_serial = g_frame_serial;
   }
-  ~TraceForRun() { end_build_mode(); }
-  TraceForRun(const TraceForRun &) = delete;
-  TraceForRun &operator=(const TraceForRun &) = delete;
+  ResidualProgram &program() { return session_.program(); }
+
+private:
+  BuildSession session_; // first made, last gone
 };
 
 // Statements a loaded function may hold: arithmetic, tests and loops.
@@ -159,12 +157,12 @@ CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not)
     return nullptr;
   }
   ResidualProgram program;
-  program.source_name = procedure_name(f);
   int id = -1;
   const SrcLoc call = current_call_loc(); // the trace moves it into the procedure
   try {
-    TraceForRun build(&program);
+    TraceForRun build;
     id = trace_scalar(f, who);
+    program = std::move(build.program());
   } catch (const Error &e) {
     reset_call_loc(call);
     if (std::string_view(e.what()) == "Interrupted") throw;
@@ -176,6 +174,7 @@ CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not)
     return nullptr;
   }
   reset_call_loc(call);
+  program.source_name = procedure_name(f);
   if (program.functions.size() != 2 || !program.functions[0].body.empty() ||
       !program.cells.empty() || !program.lists.empty() || program.plots != 0 ||
       !only_arithmetic(program.functions[id].body)) {

@@ -34,8 +34,6 @@ namespace sicm::build {
 
 namespace {
 
-gcvec<Value> g_list_cell_elements; // per cell: the shape of the element that asked for a new list
-
 bool contains_rtlist(Value v) {
   if (as_rtlist(v)) return true;
   if (is_pair(v)) return contains_rtlist(car(v)) || contains_rtlist(cdr(v));
@@ -48,26 +46,15 @@ bool contains_rtlist(Value v) {
 
 } // namespace
 
-std::vector<ListCell> g_list_cells;
-gcvec<Value> g_list_shapes;                   // per list: its elements' shape
-std::vector<std::vector<RType>> g_list_types; // per list: its elements' leaves' kinds
-
-void reset_lists() {
-  g_list_cell_elements.clear();
-  g_list_cells.clear();
-  g_list_shapes.clear();
-  g_list_types.clear();
-}
-
 int list_cell_of(const Value *place) {
-  for (size_t i = 0; i < g_list_cells.size(); ++i)
-    if (g_list_cells[i].place == place) return static_cast<int>(i);
+  for (size_t i = 0; i < g_build->list_cells.size(); ++i)
+    if (g_build->list_cells[i].place == place) return static_cast<int>(i);
   return -1;
 }
 
 std::vector<Value *> list_cell_places() {
   std::vector<Value *> places;
-  for (const ListCell &c : g_list_cells)
+  for (const ListCell &c : g_build->list_cells)
     places.push_back(c.place);
   return places;
 }
@@ -104,10 +91,10 @@ std::vector<RType> leaf_types(const gcvec<Value> &leaves) {
 
 // A new empty list for elements shaped like `shape`.
 int new_list(Value shape, const std::vector<RType> &types, const std::string &name) {
-  int id = static_cast<int>(g_prog->lists.size());
-  g_prog->lists.push_back(RList{static_cast<int>(types.size()), name});
-  g_list_shapes.push_back(element_shape(shape));
-  g_list_types.push_back(types);
+  int id = static_cast<int>(g_build->program.lists.size());
+  g_build->program.lists.push_back(RList{static_cast<int>(types.size()), name});
+  g_build->list_shapes.push_back(element_shape(shape));
+  g_build->list_types.push_back(types);
   RStmt s{RKind::ListNew};
   s.list = id;
   emit(std::move(s));
@@ -148,12 +135,12 @@ Value push_onto_list(Value *place, const std::string &name, Value element, SrcLo
     cannot_compile(loc, "set! of " + name + " to a list of " + describe(element) +
                             " inside a procedure that runs at run time (the elements of a list "
                             "of run-time length must be numbers, or pairs or structures of them)");
-  if (cell >= 0 && r && r->whole && r->list == g_list_cells[cell].list) {
+  if (cell >= 0 && r && r->whole && r->list == g_build->list_cells[cell].list) {
     int list = r->list;
-    if (!same_shape(element, g_list_shapes[list]))
+    if (!same_shape(element, g_build->list_shapes[list]))
       cannot_compile(loc, "set! of " + name + " to a list whose elements have different shapes, " +
-                              describe(element) + " and " + describe(g_list_shapes[list]));
-    std::vector<RType> &types = g_list_types[list];
+                              describe(element) + " and " + describe(g_build->list_shapes[list]));
+    std::vector<RType> &types = g_build->list_types[list];
     for (size_t k = 0; k < leaves.size(); ++k) {
       RType t = scalar_type(leaves[k]);
       if (t == types[k]) continue;
@@ -180,25 +167,25 @@ Value push_onto_list(Value *place, const std::string &name, Value element, SrcLo
     cannot_compile(loc,
                    "set! of " + name + " inside a procedure run by another run-time procedure");
   if (cell < 0) {
-    g_list_cells.push_back(ListCell{place, name, -1, true, {}});
-    g_list_cell_elements.push_back(element);
-    if (frame) g_cell_frames.push_back(frame);
-    cell = static_cast<int>(g_list_cells.size()) - 1;
+    g_build->list_cells.push_back(ListCell{place, name, -1, true, {}});
+    g_build->list_cell_elements.push_back(element);
+    if (frame) g_build->cell_frames.push_back(frame);
+    cell = static_cast<int>(g_build->list_cells.size()) - 1;
   }
-  g_list_cells[cell].needs_init = true;
-  g_list_cells[cell].types = leaf_types(leaves);
-  g_list_cell_elements[cell] = element_shape(element);
+  g_build->list_cells[cell].needs_init = true;
+  g_build->list_cells[cell].types = leaf_types(leaves);
+  g_build->list_cell_elements[cell] = element_shape(element);
   retry_for_list(in_loop);
 }
 
 // Start the lists that pushes asked for, from the values their variables
 // hold (before the primitive that is traced again).
 void init_list_cells() {
-  for (size_t i = 0; i < g_list_cells.size(); ++i) {
-    ListCell &c = g_list_cells[i];
+  for (size_t i = 0; i < g_build->list_cells.size(); ++i) {
+    ListCell &c = g_build->list_cells[i];
     if (!c.needs_init) continue;
     c.needs_init = false;
-    Value element = g_list_cell_elements[i];
+    Value element = g_build->list_cell_elements[i];
     const std::vector<RType> &types = c.types;
     c.list = new_list(element, types, c.name);
     gcvec<Value> items = list_to_vector(*c.place);
@@ -218,7 +205,7 @@ void init_list_cells() {
 
 // A list cell's variable holding its whole list gets the list's length now.
 void read_list_cells() {
-  for (ListCell &c : g_list_cells) {
+  for (ListCell &c : g_build->list_cells) {
     RtList *r = as_rtlist(*c.place);
     if (!r || !r->whole || r->list != c.list) continue;
     RStmt s{RKind::Let};
@@ -242,7 +229,7 @@ Value list_position(const RtList *r, Value k) {
 // Element k of r, read at run time (who: for the error if there is none).
 Value list_element(const RtList *r, Value k, const char *who) {
   Value position = list_position(r, k);
-  const std::vector<RType> &types = g_list_types[r->list];
+  const std::vector<RType> &types = g_build->list_types[r->list];
   gcvec<Value> leaves;
   for (size_t i = 0; i < types.size(); ++i) {
     RStmt s{RKind::Let};
@@ -257,7 +244,7 @@ Value list_element(const RtList *r, Value k, const char *who) {
     leaves.push_back(v);
   }
   const Value *p = leaves.data();
-  return result_like(g_list_shapes[r->list], p);
+  return result_like(g_build->list_shapes[r->list], p);
 }
 
 // r without its first k elements.
@@ -425,10 +412,10 @@ Value apply_to_rtlist(Value *a, int n) {
     cannot_compile(here(), "apply of " + describe(a[0]) +
                                " to a list whose length is known only at run time (only min, "
                                "max, + and * are compiled)");
-  const std::vector<RType> &types = g_list_types[r->list];
-  if (types.size() != 1 || types[0] == RType::Boolean || !is_scalar(g_list_shapes[r->list]))
+  const std::vector<RType> &types = g_build->list_types[r->list];
+  if (types.size() != 1 || types[0] == RType::Boolean || !is_scalar(g_build->list_shapes[r->list]))
     cannot_compile(here(), std::string("apply of ") + folds[op] + " to a list of " +
-                               describe(g_list_shapes[r->list]) + ", not of numbers");
+                               describe(g_build->list_shapes[r->list]) + ", not of numbers");
   Value v = new_var(types[0]);
   RStmt s{RKind::Let};
   s.compute = RCompute::ListFold;
@@ -523,14 +510,14 @@ Value map_over_lists(Value f, Value *lists, int nlists, bool collect, const char
   {
     struct Scope { // the loop's body receives the statements
       Scope(std::vector<RStmt> *body, gcvec<Assignment> *log) {
-        g_blocks.push_back(body);
-        g_undo.push_back(log);
-        g_undo_serials.push_back(g_frame_serial);
+        g_build->blocks.push_back(body);
+        g_build->undo.push_back(log);
+        g_build->undo_serials.push_back(g_frame_serial);
       }
       ~Scope() {
-        g_blocks.pop_back();
-        g_undo.pop_back();
-        g_undo_serials.pop_back();
+        g_build->blocks.pop_back();
+        g_build->undo.pop_back();
+        g_build->undo_serials.pop_back();
       }
     } scope(&body, &log);
     Value done = let(RCompute::LessEq, {expr_of(n, who), expr_of(i, who)}, RType::Boolean);

@@ -54,7 +54,6 @@ void throw_not_a_loop() {
 }
 
 const OpaqueKind kBottomKind = {"run-time-loop-continuation", write_bottom, nullptr};
-Value g_bottom;
 
 bool is_bottom(Value v) {
   return v.is(Tag::Opaque) && v.as<Opaque>()->kind == &kBottomKind;
@@ -117,8 +116,6 @@ bool same_shape(Value a, Value b) {
   return true;
 }
 
-namespace {
-
 // A parameter of a loop: known (the first call's argument, which every
 // call must repeat) or a loop variable: a number, a truth value, or a
 // list, structure or vector of them, one C variable per leaf.
@@ -131,7 +128,7 @@ struct LoopParam {
 
 struct ActiveLoop {
   Closure *closure;
-  size_t depth = 0;        // g_open.size(): the function the loop is in
+  size_t depth = 0;        // g_build->open.size(): the function the loop is in
   uint32_t serial = 0;     // g_frame_serial when the current attempt began
   bool watching = false;   // evaluated as an ordinary call until it calls itself
   gcvec<LoopParam> params; // holds Values: collected memory
@@ -139,10 +136,11 @@ struct ActiveLoop {
   bool from_known = false; // every argument of the first call was known (see StaticWatch)
 };
 
+namespace {
+
 struct BecomeLoop { // a watched call called itself: evaluate it as a loop
   Closure *closure;
 };
-std::vector<ActiveLoop *> g_loops; // loops whose bodies are being evaluated, innermost last
 
 // Make parameter p a loop variable shaped like v (a retry follows).
 void make_variable(LoopParam &p, Value v) {
@@ -192,7 +190,7 @@ Value record_continue(ActiveLoop &loop, Value *a, long n) {
   }
   emit(std::move(s));
   loop.continued = true;
-  return g_bottom;
+  return g_build->bottom;
 }
 
 // Restores the builder's stacks and the program's size when a loop attempt
@@ -200,27 +198,28 @@ Value record_continue(ActiveLoop &loop, Value *a, long n) {
 class LoopAttempt {
 public:
   LoopAttempt(ActiveLoop *loop, std::vector<RStmt> *block)
-      : nfunctions_(g_prog->functions.size()), nvars_(g_prog->vars.size()), nloops_(g_loops.size()),
-        nblocks_(g_blocks.size()), nundo_(g_undo.size()) {
-    g_loops.push_back(loop);
-    g_blocks.push_back(block);
-    g_undo.push_back(&log_);
-    g_undo_serials.push_back(g_frame_serial);
+      : nfunctions_(g_build->program.functions.size()), nvars_(g_build->program.vars.size()),
+        nloops_(g_build->loops.size()), nblocks_(g_build->blocks.size()),
+        nundo_(g_build->undo.size()) {
+    g_build->loops.push_back(loop);
+    g_build->blocks.push_back(block);
+    g_build->undo.push_back(&log_);
+    g_build->undo_serials.push_back(g_frame_serial);
   }
   ~LoopAttempt() {
-    g_loops.resize(nloops_);
-    g_blocks.resize(nblocks_);
-    g_undo.resize(nundo_);
-    g_undo_serials.resize(nundo_);
+    g_build->loops.resize(nloops_);
+    g_build->blocks.resize(nblocks_);
+    g_build->undo.resize(nundo_);
+    g_build->undo_serials.resize(nundo_);
   }
   // Forget everything the attempt made.
   void roll_back() {
     for (auto a = log_.rbegin(); a != log_.rend(); ++a)
       *a->place = a->before;
-    for (size_t v = nvars_; v < g_prog->vars.size(); ++v)
-      g_var_of.erase(g_prog->vars[v].sym);
-    g_prog->functions.resize(nfunctions_);
-    g_prog->vars.resize(nvars_);
+    for (size_t v = nvars_; v < g_build->program.vars.size(); ++v)
+      g_build->var_ids.erase(g_build->program.vars[v].sym);
+    g_build->program.functions.resize(nfunctions_);
+    g_build->program.vars.resize(nvars_);
   }
   const gcvec<Assignment> &log() const { return log_; }
 
@@ -238,15 +237,15 @@ bool count_known_call(Closure *c);
 // Is a variable of `frame` (null: a global) kept from one iteration to the
 // next of the loop being evaluated for run time, in the same function?
 bool grows_in_loop(Frame *frame) {
-  if (g_loops.empty()) return false;
-  const ActiveLoop *loop = g_loops.back();
-  return !loop->watching && loop->depth == g_open.size() &&
+  if (g_build->loops.empty()) return false;
+  const ActiveLoop *loop = g_build->loops.back();
+  return !loop->watching && loop->depth == g_build->open.size() &&
          (!frame || frame->serial <= loop->serial);
 }
 
 bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
   Closure *c = f.as<Closure>();
-  for (auto l = g_loops.rbegin(); l != g_loops.rend(); ++l)
+  for (auto l = g_build->loops.rbegin(); l != g_build->loops.rend(); ++l)
     if ((*l)->closure == c) {
       if ((*l)->watching) throw BecomeLoop{c};
       *out = record_continue(**l, slots, n);
@@ -283,7 +282,7 @@ bool hook_call_closure(Value f, Value *slots, long n, Value *out) {
       }
     }
     if (!recursive) {
-      if (!g_undo.empty()) // an enclosing alternative undoes these assignments too
+      if (!g_build->undo.empty()) // an enclosing alternative undoes these assignments too
         for (const Assignment &a : assigned)
           log_assignment(a);
       for (RStmt &x : body)
@@ -326,7 +325,7 @@ bool evaluate_as_loop(Value f, Value *slots, long n, Value *out, bool from_known
     {
       LoopAttempt attempt(&loop, &body);
       loop.continued = false;
-      loop.depth = g_open.size();
+      loop.depth = g_build->open.size();
       loop.serial = g_frame_serial;
       read_list_cells(); // their lengths as each iteration begins
       gcvec<Value> args(slots, slots + n);
@@ -368,7 +367,7 @@ bool evaluate_as_loop(Value f, Value *slots, long n, Value *out, bool from_known
       init_list_cells(); // lists the body conses onto start before the loop
       continue;
     }
-    if (!g_undo.empty()) // an enclosing alternative undoes these assignments too
+    if (!g_build->undo.empty()) // an enclosing alternative undoes these assignments too
       for (const Assignment &a : assigned)
         log_assignment(a);
     bool calls = block_calls(body);
@@ -450,19 +449,19 @@ namespace {
 class Trial {
 public:
   explicit Trial(std::vector<RStmt> *block)
-      : nfunctions_(g_prog->functions.size()), nvars_(g_prog->vars.size()),
-        nlists_(g_prog->lists.size()), ntables_(g_prog->tables.size()), nblocks_(g_blocks.size()),
-        nundo_(g_undo.size()) {
+      : nfunctions_(g_build->program.functions.size()), nvars_(g_build->program.vars.size()),
+        nlists_(g_build->program.lists.size()), ntables_(g_build->program.tables.size()),
+        nblocks_(g_build->blocks.size()), nundo_(g_build->undo.size()) {
     for (Value *place : list_cell_places())
       saved_lists_.push_back(*place);
-    g_blocks.push_back(block);
-    g_undo.push_back(&log_);
-    g_undo_serials.push_back(g_frame_serial);
+    g_build->blocks.push_back(block);
+    g_build->undo.push_back(&log_);
+    g_build->undo_serials.push_back(g_frame_serial);
   }
   ~Trial() {
-    g_blocks.resize(nblocks_);
-    g_undo.resize(nundo_);
-    g_undo_serials.resize(nundo_);
+    g_build->blocks.resize(nblocks_);
+    g_build->undo.resize(nundo_);
+    g_build->undo_serials.resize(nundo_);
   }
   Trial(const Trial &) = delete;
   Trial &operator=(const Trial &) = delete;
@@ -470,18 +469,18 @@ public:
   void roll_back() {
     for (auto a = log_.rbegin(); a != log_.rend(); ++a)
       *a->place = a->before;
-    for (size_t v = nvars_; v < g_prog->vars.size(); ++v)
-      g_var_of.erase(g_prog->vars[v].sym);
-    g_prog->functions.resize(nfunctions_);
-    g_prog->vars.resize(nvars_);
-    g_prog->tables.resize(ntables_);
+    for (size_t v = nvars_; v < g_build->program.vars.size(); ++v)
+      g_build->var_ids.erase(g_build->program.vars[v].sym);
+    g_build->program.functions.resize(nfunctions_);
+    g_build->program.vars.resize(nvars_);
+    g_build->program.tables.resize(ntables_);
     bool lists_in_use = false; // by a list cell started meanwhile
-    for (const ListCell &c : g_list_cells)
+    for (const ListCell &c : g_build->list_cells)
       lists_in_use = lists_in_use || c.list >= static_cast<int>(nlists_);
     if (!lists_in_use) {
-      g_prog->lists.resize(nlists_);
-      g_list_shapes.resize(nlists_);
-      g_list_types.resize(nlists_);
+      g_build->program.lists.resize(nlists_);
+      g_build->list_shapes.resize(nlists_);
+      g_build->list_types.resize(nlists_);
     }
     std::vector<Value *> places = list_cell_places();
     for (size_t i = 0; i < saved_lists_.size() && i < places.size(); ++i)
@@ -500,7 +499,7 @@ private:
 // current block, and an enclosing alternative or loop undoes its
 // assignments too.
 void keep_trial(std::vector<RStmt> &block, const gcvec<Assignment> &assigned) {
-  if (!g_undo.empty())
+  if (!g_build->undo.empty())
     for (const Assignment &a : assigned)
       log_assignment(a);
   std::vector<RStmt> &to = current_block();
@@ -523,7 +522,7 @@ bool does_run_time_work(Value f, gcvec<Value> args) {
   Trial trial(&block);
   try {
     Value r = apply_procedure(f, args.data(), static_cast<int>(args.size()));
-    work = contains_dynamic(r) || g_prog->functions.size() > trial.nfunctions();
+    work = contains_dynamic(r) || g_build->program.functions.size() > trial.nfunctions();
     for (const RStmt &s : block)
       work = work || s.kind != RKind::Text;
   } catch (const Error &) {
@@ -601,17 +600,17 @@ Value constant_list(Value shape, std::vector<double> data, long count, const cha
   element_leaves(shape, leaves);
   int width = static_cast<int>(leaves.size());
   int table = -1;
-  for (size_t t = 0; t < g_prog->tables.size(); ++t)
-    if (g_prog->tables[t].width == width && g_prog->tables[t].data == data)
+  for (size_t t = 0; t < g_build->program.tables.size(); ++t)
+    if (g_build->program.tables[t].width == width && g_build->program.tables[t].data == data)
       table = static_cast<int>(t);
   if (table < 0) {
-    table = static_cast<int>(g_prog->tables.size());
-    g_prog->tables.push_back(RTable{width, std::move(data)});
+    table = static_cast<int>(g_build->program.tables.size());
+    g_build->program.tables.push_back(RTable{width, std::move(data)});
   }
-  int id = static_cast<int>(g_prog->lists.size());
-  g_prog->lists.push_back(RList{width, std::string("constant list for ") + who});
-  g_list_shapes.push_back(element_shape(shape));
-  g_list_types.push_back(std::vector<RType>(leaves.size(), RType::Real));
+  int id = static_cast<int>(g_build->program.lists.size());
+  g_build->program.lists.push_back(RList{width, std::string("constant list for ") + who});
+  g_build->list_shapes.push_back(element_shape(shape));
+  g_build->list_types.push_back(std::vector<RType>(leaves.size(), RType::Real));
   RStmt s{RKind::ListConst};
   s.list = id;
   s.leaf = table;
@@ -672,14 +671,14 @@ bool map_over_static_lists(Value *a, int n, bool collect, const char *who, Value
 // is evaluated as usual, unrolled, and no closure of its lambda is watched
 // again.
 
-namespace {
-
 struct StaticWatch {
   Closure *closure;
   uint64_t calls = 0;     // calls of the closure with known arguments while watched
-  uint64_t work_mark = 0; // g_work when the current window of calls began
-  int branch_depth = 0;   // g_branch_depth when the watch began
+  uint64_t work_mark = 0; // g_build->work when the current window of calls began
+  int branch_depth = 0;   // g_build->branch_depth when the watch began
 };
+
+namespace {
 
 // A watched loop whose known calls nest this deep under tests on run-time
 // values is left for run time at once: each iteration's test is one more
@@ -690,31 +689,19 @@ constexpr int kMaxWatchedBranchDepth = kMaxBranchDepth / 2;
 struct UnrollLimit { // thrown to the watched call of `closure`
   Closure *closure;
 };
-std::vector<StaticWatch *> g_watches;
-std::unordered_set<Lambda *> g_unrolled_lambdas; // whose loops could not be left for run time
-
-} // namespace
-
-void reset_loops() {
-  g_loops.clear();
-  g_watches.clear();
-  g_unrolled_lambdas.clear();
-}
-
-namespace {
 
 // A call of c with known arguments: if c is watched, count it (and throw
 // UnrollLimit past the limit) and say so.
 bool count_known_call(Closure *c) {
-  for (auto w = g_watches.rbegin(); w != g_watches.rend(); ++w) {
+  for (auto w = g_build->watches.rbegin(); w != g_build->watches.rend(); ++w) {
     StaticWatch &watch = **w;
     if (watch.closure != c) continue;
-    if (g_branch_depth - watch.branch_depth >= kMaxWatchedBranchDepth) throw UnrollLimit{c};
+    if (g_build->branch_depth - watch.branch_depth >= kMaxWatchedBranchDepth) throw UnrollLimit{c};
     uint64_t limit = current_limits().max_unrolled_iterations;
     uint64_t window = std::max<uint64_t>(1, limit / 2);
     if (++watch.calls % window == 0) {
-      if (watch.calls >= limit && g_work > watch.work_mark) throw UnrollLimit{c};
-      watch.work_mark = g_work;
+      if (watch.calls >= limit && g_build->work > watch.work_mark) throw UnrollLimit{c};
+      watch.work_mark = g_build->work;
     }
     return true;
   }
@@ -723,18 +710,19 @@ bool count_known_call(Closure *c) {
 
 bool watch_known_call(Value f, Value *slots, long n, Value *out) {
   Closure *c = f.as<Closure>();
-  if (current_limits().max_unrolled_iterations == kUnlimited || g_unrolled_lambdas.count(c->lambda))
+  if (current_limits().max_unrolled_iterations == kUnlimited ||
+      g_build->unrolled_lambdas.count(c->lambda))
     return false;
-  StaticWatch watch{c, 0, g_work, g_branch_depth};
+  StaticWatch watch{c, 0, g_build->work, g_build->branch_depth};
   std::vector<RStmt> block;
   Value v;
   gcvec<Assignment> assigned;
   bool limit_hit = false;
   {
     Trial trial(&block);
-    g_watches.push_back(&watch);
+    g_build->watches.push_back(&watch);
     struct Pop {
-      ~Pop() { g_watches.pop_back(); }
+      ~Pop() { g_build->watches.pop_back(); }
     } pop;
     gcvec<Value> args(slots, slots + n);
     try {
@@ -755,7 +743,7 @@ bool watch_known_call(Value f, Value *slots, long n, Value *out) {
     return true;
   }
   if (evaluate_as_loop(f, slots, n, out, true)) return true;
-  g_unrolled_lambdas.insert(c->lambda);
+  g_build->unrolled_lambdas.insert(c->lambda);
   return false;
 }
 

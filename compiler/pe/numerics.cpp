@@ -35,34 +35,34 @@ class FunctionScope {
 public:
   FunctionScope(const std::string &name) {
     RFunction f;
-    f.id = static_cast<int>(g_prog->functions.size());
-    f.parent = g_open.back();
+    f.id = static_cast<int>(g_build->program.functions.size());
+    f.parent = g_build->open.back();
     f.name = name;
     f.loc = here();
-    g_prog->functions.push_back(std::move(f));
-    g_open.push_back(g_prog->functions.back().id);
-    g_blocks.push_back(nullptr);
-    g_function_serials.push_back(g_frame_serial);
-    saved_depth_ = g_branch_depth;
-    g_branch_depth = 0; // a test inside the traced procedure is its own
-    for (const RCell &c : g_prog->cells)
+    g_build->program.functions.push_back(std::move(f));
+    g_build->open.push_back(g_build->program.functions.back().id);
+    g_build->blocks.push_back(nullptr);
+    g_build->function_serials.push_back(g_frame_serial);
+    saved_depth_ = g_build->branch_depth;
+    g_build->branch_depth = 0; // a test inside the traced procedure is its own
+    for (const RCell &c : g_build->program.cells)
       saved_.push_back(*c.place);
     for (Value *place : list_cell_places())
       saved_lists_.push_back(place ? *place : Value::nil());
     read_cells();
   }
   ~FunctionScope() {
-    g_open.pop_back();
-    g_blocks.pop_back();
-    g_function_serials.pop_back();
-    g_branch_depth = saved_depth_;
-    for (size_t i = 0; i < saved_.size() && i < g_prog->cells.size(); ++i)
-      *g_prog->cells[i].place = saved_[i];
+    g_build->open.pop_back();
+    g_build->blocks.pop_back();
+    g_build->function_serials.pop_back();
+    g_build->branch_depth = saved_depth_;
+    for (size_t i = 0; i < saved_.size() && i < g_build->program.cells.size(); ++i)
+      *g_build->program.cells[i].place = saved_[i];
     std::vector<Value *> places = list_cell_places();
     for (size_t i = 0; i < saved_lists_.size() && i < places.size(); ++i)
       *places[i] = saved_lists_[i];
   }
-  int id() const { return g_open.back(); }
+  int id() const { return g_build->open.back(); }
 
 private:
   int saved_depth_;
@@ -346,7 +346,7 @@ bool is_scalar_leaf(Value v) {
 // run-time value, a call only if it is a linear solve.
 bool run_time_node(ExprId id) {
   const ExprNode &n = expr_node(id);
-  if (n.kind == ExprKind::Symbol) return g_var_of.count(n.sym) > 0;
+  if (n.kind == ExprKind::Symbol) return g_build->var_ids.count(n.sym) > 0;
   return n.kind != ExprKind::Call || is_solve_node(id);
 }
 
@@ -396,7 +396,7 @@ void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
 void check_taylor(const RStmt &s, const char *who) {
   if (s.method != "sicm_ode_step_taylor" && s.method != "sicm_ode_step_taylor_extended") return;
   const char *method = s.method == "sicm_ode_step_taylor" ? "taylor" : "taylor-extended";
-  const RFunction &f = g_prog->functions[s.callee];
+  const RFunction &f = g_build->program.functions[s.callee];
   if (!f.body.empty())
     cannot_compile(s.loc, std::string(who) + ": " + method +
                               " needs a system derivative that is one expression of the state; "
@@ -404,7 +404,7 @@ void check_taylor(const RStmt &s, const char *who) {
                               "integrator");
   Trace t;
   for (int v : f.inputs)
-    t.inputs.push_back(g_prog->vars[v].sym);
+    t.inputs.push_back(g_build->program.vars[v].sym);
   t.outputs = f.outputs;
   std::string why_not;
   auto any_symbol = [](Symbol *) { return std::string("p[0]"); };
@@ -420,22 +420,23 @@ void check_taylor(const RStmt &s, const char *who) {
 // fails (codegen/singular_factors.hpp).
 void trace_singular_factors(Value state, RStmt &s) {
   std::vector<Symbol *> from;
-  for (int v : g_prog->functions[s.callee].inputs)
-    from.push_back(g_prog->vars[v].sym);
+  for (int v : g_build->program.functions[s.callee].inputs)
+    from.push_back(g_build->program.vars[v].sym);
   std::vector<std::string> paths = state_leaf_paths(state, "state");
   std::unordered_map<Symbol *, std::string> names;
   for (size_t i = 0; i < from.size() && i < paths.size(); ++i)
     names[from[i]] = paths[i];
-  SingularFactors factors = singular_factors(g_prog->functions[s.callee].outputs, [&](Symbol *sym) {
-    auto it = names.find(sym);
-    return it == names.end() ? std::string() : it->second;
-  });
+  SingularFactors factors =
+      singular_factors(g_build->program.functions[s.callee].outputs, [&](Symbol *sym) {
+        auto it = names.find(sym);
+        return it == names.end() ? std::string() : it->second;
+      });
   if (factors.values.empty()) return;
   FunctionScope scope("singular_factors");
   input_like(state);
   std::vector<Symbol *> to;
   for (int v : current().inputs)
-    to.push_back(g_prog->vars[v].sym);
+    to.push_back(g_build->program.vars[v].sym);
   current().outputs = with_inputs(factors.values, from, to);
   s.probe = scope.id();
   s.probe_texts = std::move(factors.texts);
@@ -448,7 +449,7 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
   if (s.method != "sicm_ode_step_msbdf" && s.method != "sicm_ode_step_cvode_bdf") return;
   Symbol *d = intern("D").symbol();
   if (!d->bound) return;
-  size_t nfunctions = g_prog->functions.size(), nvars = g_prog->vars.size();
+  size_t nfunctions = g_build->program.functions.size(), nvars = g_build->program.vars.size();
   try {
     FunctionScope scope("jacobian");
     Value dsys = apply_procedure(d->global, &sysder, 1);
@@ -462,10 +463,10 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
     current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
     s.jacobian = scope.id();
   } catch (const Error &) {
-    for (size_t v = nvars; v < g_prog->vars.size(); ++v)
-      g_var_of.erase(g_prog->vars[v].sym);
-    g_prog->functions.resize(nfunctions);
-    g_prog->vars.resize(nvars);
+    for (size_t v = nvars; v < g_build->program.vars.size(); ++v)
+      g_build->var_ids.erase(g_build->program.vars[v].sym);
+    g_build->program.functions.resize(nfunctions);
+    g_build->program.vars.resize(nvars);
     s.jacobian = -1;
   }
 }
@@ -518,7 +519,7 @@ Value advance(NativeProc *self, Value *a, int n) {
 
 Value P_state_advancer(Value *a, int n) {
   return make_named(retrying_native<advance>, sysder_of(a, n, "state-advancer"),
-                    &g_advancer_lambda);
+                    &g_build->advancer_lambda);
 }
 
 Value run_evolve(NativeProc *self, Value *a, int n) {
@@ -549,12 +550,11 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
 }
 
 Value P_evolve(Value *a, int n) {
-  return make_named(retrying_native<run_evolve>, sysder_of(a, n, "evolve"), &g_evolver_lambda);
+  return make_named(retrying_native<run_evolve>, sysder_of(a, n, "evolve"),
+                    &g_build->evolver_lambda);
 }
 
 } // namespace
-
-Lambda g_advancer_lambda, g_evolver_lambda;
 
 void rebind_numerical_primitives() {
   rebind("definite-integral", 3, 5, retrying<P_definite_integral>);

@@ -47,7 +47,7 @@ Value P_frame(Value *a, int n) {
   }
   if (!(r[1] > r[0])) bad_range(a[1], 2, who);
   if (!(r[3] > r[2])) bad_range(a[3], 4, who);
-  s.plot = ++g_prog->plots;
+  s.plot = ++g_build->program.plots;
   s.title = n > 4 ? std::string(arg_string(a, 4, who)) : "";
   s.text = plot_file_name(s.title, s.plot);
   for (int i = 5; i < n; ++i) // the axis labels

@@ -9,6 +9,7 @@
 #include <functional>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "base/srcloc.hpp"
@@ -30,24 +31,87 @@ constexpr long kMaxBranchEvaluations = 200000;
 
 // ---- the state of the build -----------------------------------------------------------------
 
-extern ResidualProgram *g_prog;                    // the program being built
-extern std::vector<int> g_open;                    // functions being traced, innermost last
-extern std::unordered_map<Symbol *, int> g_var_of; // residual variable of a symbol
-// Tests on run-time values whose alternatives are being evaluated, nested,
-// in the innermost traced function.
-extern int g_branch_depth;
-// Where statements go, innermost last; null: the open function's body (see
-// current_block).
-extern std::vector<std::vector<RStmt> *> g_blocks;
-extern uint64_t g_work; // statements recorded other than output text (see StaticWatch)
-// Per cell of g_prog: whether main has given it its global's value yet
-// (with_retrace); read_cells reads only those.
-extern std::vector<bool> g_cell_initialized;
-extern gcvec<Frame *> g_cell_frames; // keeps the frames of local cells alive (a scanned vector)
-extern std::vector<uint32_t> g_function_serials; // g_frame_serial when each open function began
-// What the procedures state-advancer and evolve return print as
-// (pe/numerics.cpp).
-extern Lambda g_advancer_lambda, g_evolver_lambda;
+// Globals assigned while an alternative is evaluated: their values before
+// and after, so the other alternative starts from the same state and both
+// outcomes can be merged (pe/branches.cpp).
+struct Assignment {
+  Value *place; // a global's value or a frame slot
+  Value before, after;
+  uint32_t serial = 0; // the frame's serial (0 for a global)
+};
+
+// A variable that holds a run-time list: a list cell (pe/lists.cpp).
+struct ListCell {
+  Value *place; // the variable (a global's value or a frame slot)
+  std::string name;
+  int list = -1;            // the list the variable holds now
+  bool needs_init = true;   // the next push starts a new list from the variable's value
+  std::vector<RType> types; // of the element whose push asked for a new list
+};
+
+struct ActiveLoop;  // a loop whose body is being evaluated (pe/loops.cpp)
+struct StaticWatch; // a call with known arguments being counted (pe/loops.cpp)
+
+// Everything one build keeps while the program runs in build mode, owned by
+// one object: begin_build_mode makes it the build in progress (g_build),
+// end_build_mode forgets it. It holds Values, so it lives where the
+// collector looks (its owner's stack).
+struct BuildState {
+  ResidualProgram program; // what the build leaves for run time
+
+  // ---- pe/build_mode.cpp
+  std::vector<int> open;                         // functions being traced, innermost last
+  std::unordered_map<Symbol *, int> var_ids;     // residual variable of a symbol
+  std::unordered_map<ExprId, bool> dynamic_memo; // does an expression mention a variable?
+  // Tests on run-time values whose alternatives are being evaluated, nested,
+  // in the innermost traced function.
+  int branch_depth = 0;
+  // Where statements go, innermost last; null: the open function's body (see
+  // current_block).
+  std::vector<std::vector<RStmt> *> blocks{nullptr};
+  uint64_t work = 0; // statements recorded other than output text (see StaticWatch)
+  // Per cell of the program: whether main has given it its global's value
+  // yet (with_retrace); read_cells reads only those.
+  std::vector<bool> cell_initialized;
+  gcvec<Frame *> cell_frames; // keeps the frames of local cells alive (a scanned vector)
+  std::vector<uint32_t> function_serials; // g_frame_serial when each open function began
+  // The primitives rebound, and what each name held before (for end_build_mode).
+  std::unordered_map<std::string, PrimFn> original_fns;
+  std::vector<Symbol *> rebound;
+  gcvec<Value> rebound_values; // scanned: the primitives' objects stay alive
+  std::vector<bool> rebound_bound;
+
+  // ---- pe/numerics.cpp: what the procedures state-advancer and evolve return print as
+  Lambda advancer_lambda, evolver_lambda;
+
+  // ---- pe/branches.cpp
+  std::vector<gcvec<Assignment> *> undo; // logs of assignments to undo, innermost last
+  std::vector<uint32_t> undo_serials;    // g_frame_serial when each log began
+  long branch_evaluations = 0;           // alternatives evaluated under tests on run-time values
+  std::vector<size_t> capture_depths;    // open.size() when each with-output-to-string began
+
+  // ---- pe/lists.cpp
+  std::vector<ListCell> list_cells; // the variables that hold run-time lists
+  gcvec<Value> list_cell_elements;  // per cell: the shape of the element that asked for a new list
+  gcvec<Value> list_shapes;         // per list: its elements' shape
+  std::vector<std::vector<RType>> list_types; // per list: its elements' leaves' kinds
+
+  // ---- pe/loops.cpp
+  // The value of a recursive call of the loop being evaluated: it never
+  // reaches a result (a test whose alternative it is selects the other).
+  Value bottom;
+  std::vector<ActiveLoop *> loops; // loops whose bodies are being evaluated, innermost last
+  std::vector<StaticWatch *> watches;
+  std::unordered_set<Lambda *> unrolled_lambdas; // whose loops could not be left for run time
+
+  // ---- pe/for_run.cpp
+  uint32_t trace_serial = 0; // g_frame_serial when a trace for sicm run began
+};
+
+// The build in progress, or null (sicm run). The one global of the partial
+// evaluator: the evaluator's hooks and the rebound primitives, which are
+// plain functions, reach the build through it.
+extern BuildState *g_build;
 
 // ---- run-time values ----------------------------------------------------------------------
 
@@ -132,24 +196,7 @@ void rebind_plot_primitives();      // pe/plots.cpp
 void rebind_list_primitives();      // pe/lists.cpp
 void rebind_parallel_primitives();  // pe/parallel.cpp
 
-// Empty the state of each part, for end_build_mode.
-void reset_branches(); // pe/branches.cpp
-void reset_lists();    // pe/lists.cpp
-void reset_loops();    // pe/loops.cpp
-
 // ---- branches on run-time values (pe/branches.cpp) -------------------------------------
-
-// Globals assigned while an alternative is evaluated: their values before
-// and after, so the other alternative starts from the same state and both
-// outcomes can be merged.
-struct Assignment {
-  Value *place; // a global's value or a frame slot
-  Value before, after;
-  uint32_t serial = 0; // the frame's serial (0 for a global)
-};
-
-extern std::vector<gcvec<Assignment> *> g_undo; // logs of assignments to undo, innermost last
-extern std::vector<uint32_t> g_undo_serials;    // g_frame_serial when each log began
 
 // Add a to the innermost log, if its variable is older than the log.
 void log_assignment(const Assignment &a);
@@ -190,14 +237,11 @@ std::string procedure_name(Value proc);
 
 struct LoopRetry {}; // evaluate the loop's body again with more loop variables
 
-// The value of a recursive call of the loop being evaluated: it never
-// reaches a result (a test whose alternative it is selects the other).
-extern Value g_bottom;
-extern const OpaqueKind kBottomKind; // g_bottom's kind
+extern const OpaqueKind kBottomKind; // the kind of BuildState::bottom
 
 // Throw LoopAbort: what is being evaluated as a loop is not one.
 [[noreturn]] void throw_not_a_loop();
-// Is v the value of a recursive call of a loop (g_bottom)?
+// Is v the value of a recursive call of a loop (g_build->bottom)?
 bool is_bottom(Value v);
 // The scalar leaves of a loop's result (a number or truth value, or a proper
 // list, structure or vector of them); false if it has others.
@@ -223,18 +267,6 @@ bool tentatively(const std::function<bool()> &body);
 bool hook_call_closure(Value f, Value *slots, long n, Value *out);
 
 // ---- lists whose length is known only at run time (pe/lists.cpp) -----------------------
-
-// A variable that holds a run-time list: a list cell.
-struct ListCell {
-  Value *place; // the variable (a global's value or a frame slot)
-  std::string name;
-  int list = -1;            // the list the variable holds now
-  bool needs_init = true;   // the next push starts a new list from the variable's value
-  std::vector<RType> types; // of the element whose push asked for a new list
-};
-extern std::vector<ListCell> g_list_cells;           // the variables that hold run-time lists
-extern gcvec<Value> g_list_shapes;                   // per list: its elements' shape
-extern std::vector<std::vector<RType>> g_list_types; // per list: its elements' leaves' kinds
 
 // The index of the list cell whose variable is *place, or -1.
 int list_cell_of(const Value *place);
