@@ -1,4 +1,5 @@
-// `sicm build`: run in build mode, emit the residual program, call cc (see build_exe.hpp).
+// The last pass of `sicm build`: the generated C compiled by the system C
+// compiler against the runtime (see build_exe.hpp).
 #include "driver/build_exe.hpp"
 
 #include <spawn.h>
@@ -15,17 +16,7 @@
 #include <vector>
 
 #include "base/error.hpp"
-#include "builtins/effects_used.hpp"
 #include "codegen/jit.hpp"
-#include "codegen/kernel_report.hpp"
-#include "codegen/residual_dump.hpp"
-#include "codegen/residual_emit.hpp"
-#include "eval/analyze.hpp"
-#include "eval/analyzed_dump.hpp"
-#include "eval/core.hpp"
-#include "eval/interp.hpp"
-#include "pe/build.hpp"
-#include "syntax/reader.hpp"
 
 extern char **environ;
 
@@ -33,7 +24,6 @@ namespace sicm {
 
 namespace {
 
-constexpr int kExitNoInput = 66;   // EX_NOINPUT
 constexpr int kExitCantCreat = 73; // EX_CANTCREAT
 
 bool exists(const std::string &path) {
@@ -95,64 +85,9 @@ int run(const std::vector<std::string> &argv) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
-std::string base_name(const std::string &path) {
-  size_t slash = path.rfind('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
 } // namespace
 
-int build_program(const BuildOptions &o) {
-  std::ifstream in(o.input, std::ios::binary);
-  if (!in) {
-    std::fprintf(stderr, "sicm: cannot open %s: %s\n", o.input.c_str(), std::strerror(errno));
-    return kExitNoInput;
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  uint32_t file = register_source(o.input, text.str());
-
-  if (o.dump == "analyzed") {
-    for (const ReadForm &f : read_all(file))
-      std::printf("%s\n", dump_node(analyze_form(f.datum, f.loc, nullptr)).c_str());
-    return 0;
-  }
-  BuildSession build;
-  ResidualProgram &program = build.program();
-  program.source_name = base_name(o.input);
-  run_source(file);
-  if (o.dump == "residual") {
-    std::fputs(dump_residual(program).c_str(), stdout);
-    return 0;
-  }
-  std::string c = emit_residual_program(program);
-  if (o.dump == "kernels") {
-    std::fputs(report_table(report_kernels(program, c), used_effects()).c_str(), stdout);
-    return 0;
-  }
-  if (o.dump == "c") {
-    std::fwrite(c.data(), 1, c.size(), stdout);
-    return 0;
-  }
-
-  if (!o.report_path.empty()) {
-    std::vector<KernelReport> kernels = report_kernels(program, c);
-    std::ofstream json(o.report_path, std::ios::binary);
-    json << report_json(kernels, used_effects());
-    if (!json) {
-      std::fprintf(stderr, "sicm: error: cannot write %s\n", o.report_path.c_str());
-      return kExitCantCreat;
-    }
-    if (o.report_only) {
-      std::fputs(report_table(kernels, used_effects()).c_str(), stdout);
-      std::printf("wrote %s\n", o.report_path.c_str());
-      return 0;
-    }
-  }
-  if (o.emit_only) {
-    std::fwrite(c.data(), 1, c.size(), stdout);
-    return 0;
-  }
+int compile_executable(const std::string &c, const BuildOptions &o) {
   std::string include_dir, library;
   if (!find_runtime(&include_dir, &library)) {
     std::fprintf(stderr,

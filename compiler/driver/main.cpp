@@ -1,4 +1,5 @@
-// The sicm command: run, build, emit-c, emit-kernels, repl.
+// The sicm command: the command line, the evaluator thread, and the
+// command dispatched to its pipeline (driver/pipeline.cpp) or the REPL.
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -20,7 +21,7 @@
 #include "builtins/parameter.hpp"
 #include "builtins/plot.hpp"
 #include "codegen/kernel.hpp"
-#include "driver/build_exe.hpp"
+#include "driver/pipeline.hpp"
 #include "driver/repl.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
@@ -29,8 +30,7 @@
 
 namespace {
 
-constexpr int kExitUsage = 64;   // EX_USAGE
-constexpr int kExitNoInput = 66; // EX_NOINPUT
+constexpr int kExitUsage = 64; // EX_USAGE
 
 // The evaluator runs on a thread with a large stack so that deep (non-tail)
 // recursion in user programs works as it does in MIT Scheme; the stack guard
@@ -103,28 +103,6 @@ struct Job {
   int status = 0;
 };
 
-int run_file(const std::string &path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    std::fprintf(stderr, "sicm: cannot open %s: %s\n", path.c_str(), std::strerror(errno));
-    return kExitNoInput;
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  uint32_t file = sicm::register_source(path, text.str());
-  sicm::run_source(file);
-  return 0;
-}
-
-// sicm emit-c: the program's output is discarded (plots go to a scratch
-// directory); what is printed is the C source of each kernel compiled.
-std::string g_emitted;
-
-void collect_kernel(const sicm::Kernel *k) {
-  if (g_emitted.find(k->c_source) != std::string::npos) return; // the same kernel again
-  g_emitted += "/* ---- kernel " + k->c_name + " ---- */\n" + k->c_source + "\n";
-}
-
 // FILE.sicm without its extension (what a program's outputs are named
 // after); any other name unchanged.
 std::string without_sicm_extension(const std::string &file) {
@@ -132,41 +110,6 @@ std::string without_sicm_extension(const std::string &file) {
   if (file.size() > ext.size() && file.compare(file.size() - ext.size(), ext.size(), ext) == 0)
     return file.substr(0, file.size() - ext.size());
   return file;
-}
-
-// Run a program with its output discarded and its plots in a scratch
-// directory, removed afterwards (sicm emit-kernels, sicm bench).
-int run_quietly(const std::string &path) {
-  // Plots go to a scratch directory, removed afterwards.
-  const char *tmp = std::getenv("TMPDIR");
-  std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/sicm-emit-XXXXXX";
-  std::vector<char> dir(pattern.begin(), pattern.end());
-  dir.push_back('\0');
-  bool have_dir = mkdtemp(dir.data()) != nullptr;
-  if (have_dir) sicm::set_plot_directory(dir.data());
-  struct RemoveDir {
-    const char *path;
-    ~RemoveDir() {
-      std::error_code ignored;
-      if (path) std::filesystem::remove_all(path, ignored);
-    }
-  } remove_dir{have_dir ? dir.data() : nullptr};
-  std::fflush(stdout);
-  int saved = dup(1);
-  int null_fd = open("/dev/null", O_WRONLY);
-  if (saved >= 0 && null_fd >= 0) dup2(null_fd, 1);
-  int status = 0;
-  try {
-    status = run_file(path);
-  } catch (...) {
-    sicm::flush_output();
-    if (saved >= 0) dup2(saved, 1);
-    throw;
-  }
-  sicm::flush_output();
-  if (saved >= 0) dup2(saved, 1);
-  if (null_fd >= 0) close(null_fd);
-  return status;
 }
 
 // sicm bench FILE [--out DIR] [--methods M1,M2,...] [--tolerances FROM:TO] [--repeats N]
@@ -222,20 +165,10 @@ int bench(const std::vector<std::string> &args) {
   }
   if (o.out_dir.empty()) o.out_dir = without_sicm_extension(file) + "-bench";
   sicm::record_integration_sites(true);
-  int status = run_quietly(file);
+  int status = sicm::run_quietly(file);
   sicm::record_integration_sites(false);
   if (status != 0) return status;
   return sicm::run_work_precision(o);
-}
-
-int emit_c(const std::string &path) {
-  sicm::set_kernel_listener(collect_kernel);
-  int status = run_quietly(path);
-  if (status == 0) {
-    if (g_emitted.empty()) std::fputs("/* this program compiles no kernels */\n", stdout);
-    std::fputs(g_emitted.c_str(), stdout);
-  }
-  return status;
 }
 
 int dispatch(const std::vector<std::string> &args) {
@@ -260,7 +193,7 @@ int dispatch(const std::vector<std::string> &args) {
       std::fputs(kUsage, stderr);
       return kExitUsage;
     }
-    return emit_c(args[1]);
+    return sicm::emit_kernels(args[1]);
   }
   if (cmd == "build" || cmd == "emit-c" || cmd == "report") {
     sicm::BuildOptions o;
@@ -340,7 +273,7 @@ int dispatch(const std::vector<std::string> &args) {
       std::fputs(kUsage, stderr);
       return kExitUsage;
     }
-    return run_file(file);
+    return sicm::run_program(file);
   }
   std::fprintf(stderr, "sicm: unknown command '%s'\n%s", cmd.c_str(), kUsage);
   return kExitUsage;
