@@ -16,12 +16,6 @@ namespace sicm {
 
 namespace {
 
-constexpr OpInfo kOpInfo[] = {
-#define SICM_OP(name, scheme, arity, c) {scheme, arity, c},
-#include "cas/ops.def"
-#undef SICM_OP
-};
-
 // An expression id as a Value: numbers and symbols as themselves, anything
 // else as Tag::Expr.
 Value expr_value(ExprId id) {
@@ -204,10 +198,6 @@ Value fold_unary(Op op, Value x) {
 
 } // namespace
 
-const OpInfo &op_info(Op op) {
-  return kOpInfo[static_cast<size_t>(op)];
-}
-
 DecimalConstants::DecimalConstants() {
   ++g_decimal_constants;
 }
@@ -287,10 +277,12 @@ Value datum_to_value(Value d, const char *who) {
   int n = static_cast<int>(args.size());
   Value head = car(d);
   if (is_symbol(head)) {
-    for (size_t i = 0; i < std::size(kOpInfo); i++) {
+    size_t nops = 0;
+    const OpInfo *ops = op_table(&nops);
+    for (size_t i = 0; i < nops; i++) {
       Op op = static_cast<Op>(i);
-      if (symbol_name(head) != kOpInfo[i].scheme_name) continue;
-      int arity = kOpInfo[i].arity;
+      if (symbol_name(head) != ops[i].scheme_name) continue;
+      int arity = ops[i].arity;
       bool fits = op == Op::Atan ? n == 1 || n == 2 : arity < 0 ? n >= 1 : n == arity;
       if (fits) return symbolic_apply(op, args.data(), n);
     }

@@ -10,21 +10,9 @@
 #include <cstdint>
 
 #include "base/value.hpp"
+#include "cas/ops.hpp"
 
 namespace sicm {
-
-enum class Op : uint8_t {
-#define SICM_OP(name, scheme, arity, c) name,
-#include "cas/ops.def"
-#undef SICM_OP
-};
-
-struct OpInfo {
-  const char *scheme_name;
-  int arity; // -1: n-ary
-  const char *c_name;
-};
-const OpInfo &op_info(Op op);
 
 // A Value is "symbolic" if it is an expression or a symbol (a literal number).
 inline bool is_expression(Value v) {

@@ -82,8 +82,8 @@
 #include <unordered_set>
 #include <vector>
 
-#include "algebra/symbolic.hpp"
 #include "base/value.hpp"
+#include "cas/ops.hpp"
 
 namespace sicm {
 
