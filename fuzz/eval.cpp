@@ -43,12 +43,12 @@
 #include <vector>
 
 #include "base/error.hpp"
+#include "base/primitive.hpp"
 #include "base/srcloc.hpp"
 #include "builtins/plot.hpp"
 #include "common.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "syntax/reader.hpp"
 

@@ -17,7 +17,7 @@
 
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 

@@ -16,7 +16,7 @@
 #include <string>
 
 #include "algebra/generic.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 

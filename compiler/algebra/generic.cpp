@@ -7,7 +7,7 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "base/error.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 
 namespace sicm {
 

@@ -9,7 +9,7 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "base/number.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 
 namespace sicm {
 

@@ -59,7 +59,7 @@ ExprId solve_head();
 // instead, which the C emitter writes as a call of
 // sicm_linalg_solve_as_interpreted (sicm/linalg.h): Gauss-Jordan with the
 // interpreter's pivoting and order of operations. Build mode says which
-// values are run-time values (run_time_value_test, eval/primitive.hpp);
+// values are run-time values (run_time_value_test, base/primitive.hpp);
 // without it (sicm run) there are none.
 ExprId interpreted_solve_head();
 

@@ -18,7 +18,7 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "base/number.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 

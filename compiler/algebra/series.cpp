@@ -10,8 +10,8 @@
 #include "algebra/generic.hpp"
 #include "algebra/operator.hpp"
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "eval/core.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 

@@ -13,7 +13,7 @@
 #include "algebra/series.hpp"
 #include "algebra/symbolic.hpp"
 #include "base/number.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 

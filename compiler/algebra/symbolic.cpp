@@ -5,10 +5,10 @@
 
 #include "algebra/structure.hpp"
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "cas/expr.hpp"
 #include "cas/simplify.hpp"
 #include "eval/core.hpp"
-#include "eval/primitive.hpp"
 #include "print/printer.hpp"
 #include "sicm/runtime.h"
 

@@ -15,7 +15,7 @@
 
 #include "base/number.hpp"
 #include "base/number_internal.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 
 namespace sicm {
 

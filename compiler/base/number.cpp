@@ -14,7 +14,7 @@
 
 #include "base/error.hpp"
 #include "base/number_internal.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 #include "sicm/runtime.h"
 
 namespace sicm {

@@ -7,7 +7,7 @@
 #include <gmp.h>
 
 #include "base/number.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 
 namespace sicm {
 

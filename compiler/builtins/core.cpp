@@ -6,10 +6,10 @@
 
 #include "algebra/structure.hpp"
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "eval/analyze.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/pretty.hpp"
 #include "print/printer.hpp"

@@ -8,7 +8,7 @@
 
 #include <algorithm>
 
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 
 namespace sicm {
 

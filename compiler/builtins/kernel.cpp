@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "algebra/structure.hpp"
+#include "base/primitive.hpp"
 #include "codegen/kernel.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 

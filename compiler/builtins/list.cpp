@@ -4,9 +4,9 @@
 #include <cstdint>
 
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "eval/captured_assignment.hpp"
 #include "eval/core.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 
 namespace sicm {

@@ -9,7 +9,7 @@
 #include "base/error.hpp"
 #include "base/number.hpp"
 #include "base/number_internal.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 
 namespace sicm {
 

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "builtins/parameter.hpp"
-#include "eval/primitive.hpp"
 
 namespace sicm {
 

@@ -6,9 +6,9 @@
 #include <string>
 
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "builtins/plot.hpp"
 #include "eval/core.hpp"
-#include "eval/primitive.hpp"
 #include "sicm/runtime.h"
 
 namespace sicm {

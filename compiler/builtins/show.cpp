@@ -4,8 +4,8 @@
 // renders that datum (print/infix.cpp, print/tex.cpp).
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
+#include "base/primitive.hpp"
 #include "eval/core.hpp"
-#include "eval/primitive.hpp"
 #include "print/infix.hpp"
 
 namespace sicm {

@@ -10,9 +10,9 @@
 #include <string>
 #include <string_view>
 
+#include "base/primitive.hpp"
 #include "base/utf8.hpp"
 #include "builtins/builtins.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 

@@ -4,8 +4,8 @@
 #include <utility>
 
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "builtins/builtins.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 
 namespace sicm {

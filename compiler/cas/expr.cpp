@@ -7,7 +7,7 @@
 
 #include "base/limits.hpp"
 #include "base/number.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 
 namespace sicm {
 namespace {

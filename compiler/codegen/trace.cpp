@@ -19,6 +19,7 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "codegen/emit_c.hpp"
 #include "codegen/emit_taylor.hpp"
 #include "codegen/jit.hpp"
@@ -26,7 +27,6 @@
 #include "codegen/kernel_form.hpp"
 #include "codegen/singular_factors.hpp"
 #include "codegen/state_shape.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 

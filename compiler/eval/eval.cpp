@@ -14,8 +14,8 @@
 
 #include "algebra/structure.hpp"
 #include "base/limits.hpp"
+#include "base/primitive.hpp"
 #include "eval/core.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 

@@ -7,8 +7,8 @@
 
 #include "algebra/generic.hpp"
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "codegen/state_shape.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "pe/state.hpp"
 

@@ -6,8 +6,8 @@
 #include <string>
 
 #include "base/number.hpp"
+#include "base/primitive.hpp"
 #include "builtins/plot.hpp"
-#include "eval/primitive.hpp"
 #include "pe/state.hpp"
 
 namespace sicm::build {

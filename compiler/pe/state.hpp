@@ -12,11 +12,11 @@
 #include <unordered_set>
 #include <vector>
 
+#include "base/primitive.hpp"
 #include "base/srcloc.hpp"
 #include "base/value.hpp"
 #include "cas/expr.hpp"
 #include "codegen/residual.hpp"
-#include "eval/primitive.hpp"
 #include "eval/procedure.hpp"
 
 namespace sicm::build {

@@ -7,7 +7,7 @@
 #include <unordered_map>
 
 #include "base/number.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 #include "eval/procedure.hpp"
 
 namespace sicm {

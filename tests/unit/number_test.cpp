@@ -6,7 +6,7 @@
 
 #include "base/error.hpp"
 #include "base/number.hpp"
-#include "eval/primitive.hpp"
+#include "base/primitive.hpp"
 
 namespace sicm {
 namespace {
