@@ -47,6 +47,7 @@
 #include "base/srcloc.hpp"
 #include "builtins/plot.hpp"
 #include "common.hpp"
+#include "driver/init.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
 #include "eval/procedure.hpp"

@@ -130,6 +130,5 @@ std::string number_to_string(Value v, int radix = 10);
 // number->string string->number numerator denominator 1+ -1+ 1- square cube
 // exact-rational? exact-nonnegative-integer? nan? integer-floor
 // integer-ceiling integer-round integer-truncate random).
-void install_number_primitives();
 
 } // namespace sicm

@@ -51,6 +51,18 @@ Value make_string(std::string_view s) {
   return Value::object(Tag::String, gc_new<String>(String{gc_strdup(s), s.size()}));
 }
 
+namespace {
+ValueWriter g_value_writer = nullptr;
+} // namespace
+
+std::string written(Value v) {
+  return g_value_writer ? g_value_writer(v) : "#[value]";
+}
+
+void set_value_writer(ValueWriter writer) {
+  g_value_writer = writer;
+}
+
 Value make_vector(size_t n, Value fill) {
   Value *items = static_cast<Value *>(GC_MALLOC(sizeof(Value) * (n ? n : 1)));
   if (!items) throw std::bad_alloc();

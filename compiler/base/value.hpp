@@ -242,6 +242,16 @@ struct Opaque {
   void *obj;
 };
 
+// ---- writing values in messages --------------------------------------------
+
+// A value as MIT Scheme writes it, for the messages of the layers below
+// print/ (argument errors, the analyzer's syntax errors). print/ installs
+// its writer (write_string) when the interpreter starts; before that a
+// value is written as #[value].
+std::string written(Value v);
+using ValueWriter = std::string (*)(Value v);
+void set_value_writer(ValueWriter writer);
+
 // ---- constructors --------------------------------------------------------
 
 Value intern(std::string_view name);

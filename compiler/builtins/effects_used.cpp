@@ -5,6 +5,7 @@
 // what the scene is made of, whether or not a term folds away: a drive of
 // amplitude 0 is listed, and costs nothing (the report's op counts show it).
 #include "builtins/effects_used.hpp"
+#include "builtins/builtins.hpp"
 
 #include <algorithm>
 

@@ -13,6 +13,5 @@ const std::vector<std::string> &used_effects();
 
 // (%use-effect name): called by each effect constructor of the library.
 // Called by init_interpreter.
-void install_effect_primitives();
 
 } // namespace sicm

@@ -15,6 +15,7 @@
 
 #include "algebra/structure.hpp"
 #include "base/primitive.hpp"
+#include "builtins/builtins.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"

@@ -5,6 +5,7 @@
 
 #include "base/number.hpp"
 #include "base/primitive.hpp"
+#include "builtins/builtins.hpp"
 #include "eval/captured_assignment.hpp"
 #include "eval/core.hpp"
 #include "eval/procedure.hpp"

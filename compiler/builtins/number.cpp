@@ -10,6 +10,7 @@
 #include "base/number.hpp"
 #include "base/number_internal.hpp"
 #include "base/primitive.hpp"
+#include "builtins/builtins.hpp"
 
 namespace sicm {
 

@@ -27,6 +27,7 @@
 // point where it failed. While a primitive runs, the runtime's error hook
 // records messages instead of printing them.
 #include "builtins/numerics.hpp"
+#include "builtins/builtins.hpp"
 
 #include <algorithm>
 #include <cfloat>

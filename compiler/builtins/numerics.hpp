@@ -6,6 +6,5 @@
 
 namespace sicm {
 
-void install_numerics_primitives();
 
 } // namespace sicm

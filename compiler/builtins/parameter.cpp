@@ -11,6 +11,7 @@
 
 #include "base/number.hpp"
 #include "base/primitive.hpp"
+#include "builtins/builtins.hpp"
 #include "builtins/parameter.hpp"
 
 namespace sicm {

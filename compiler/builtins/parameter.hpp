@@ -18,6 +18,5 @@ bool fix_parameter_option(const std::string &assignment, std::string *why_not);
 bool fixed_parameter(const std::string &name, double *value);
 
 // (parameter name default). Called by init_interpreter.
-void install_parameter_primitives();
 
 } // namespace sicm

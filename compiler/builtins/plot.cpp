@@ -7,6 +7,7 @@
 
 #include "base/number.hpp"
 #include "base/primitive.hpp"
+#include "builtins/builtins.hpp"
 #include "builtins/plot.hpp"
 #include "eval/core.hpp"
 #include "sicm/runtime.h"

@@ -6,7 +6,6 @@
 
 namespace sicm {
 
-void install_plot_primitives();
 // The directory plot files are written to (default "."; `--plot-dir DIR`).
 void set_plot_directory(const std::string &dir);
 // The file name (without extension) of plot number `number` titled `title`:

@@ -5,6 +5,7 @@
 #include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "base/primitive.hpp"
+#include "builtins/builtins.hpp"
 #include "eval/core.hpp"
 #include "print/infix.hpp"
 

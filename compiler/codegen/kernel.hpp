@@ -113,6 +113,5 @@ bool value_has_shape(Value v, Value shape);
 
 // (compile-procedure proc sample ...), (kernel? x), (kernel-c-source k).
 // Called by init_interpreter.
-void install_kernel_primitives();
 
 } // namespace sicm

@@ -21,6 +21,7 @@
 #include "builtins/parameter.hpp"
 #include "builtins/plot.hpp"
 #include "codegen/kernel.hpp"
+#include "driver/init.hpp"
 #include "driver/pipeline.hpp"
 #include "driver/repl.hpp"
 #include "eval/core.hpp"

@@ -22,7 +22,6 @@
 #include <vector>
 
 #include "eval/procedure.hpp"
-#include "print/printer.hpp"
 
 namespace sicm {
 
@@ -66,7 +65,7 @@ Node *const_node(Value v, SrcLoc loc) {
 }
 
 [[noreturn]] void ill_formed(Value form, SrcLoc loc) {
-  syntax_error(loc, "Ill-formed special form: " + write_string(form));
+  syntax_error(loc, "Ill-formed special form: " + written(form));
 }
 
 // Procedures embedded by rewrites; looked up once after the primitives exist.
@@ -218,7 +217,7 @@ Value cond_expand(Value clauses, Value form, SrcLoc loc) {
   if (is_symbol(test) && symbol_name(test) == "else") {
     if (!is_null(rest))
       syntax_error(loc,
-                   "Ill-formed special form: else clause must be last in " + write_string(form));
+                   "Ill-formed special form: else clause must be last in " + written(form));
     if (is_null(body)) ill_formed(form, loc);
     return cons(sym("begin"), body);
   }
@@ -369,7 +368,7 @@ Node *Analyzer::analyze_symbol(Value x, SrcLoc loc, Scope *sc) {
 
 Node *Analyzer::analyze_pair(Value x, SrcLoc loc, Scope *sc) {
   if (list_length(x) < 0)
-    syntax_error(loc, "Combination must be a proper list: " + write_string(x));
+    syntax_error(loc, "Combination must be a proper list: " + written(x));
   int which;
   if (is_special(car(x), sc, which)) return analyze_special(which, x, loc, sc);
   return analyze_call(x, loc, sc);
@@ -443,7 +442,7 @@ Node *Analyzer::analyze_lambda(Value params, Value body, SrcLoc loc, Scope *sc, 
     if (!is_symbol(v)) ill_formed(form, loc);
     if (inner.index_of(v.symbol()) >= 0)
       syntax_error(loc_of(p, loc), "Ill-formed special form: parameter " + symbol_name(v) +
-                                       " appears twice in " + write_string(form));
+                                       " appears twice in " + written(form));
     inner.vars.push_back(v.symbol());
     if (mode == Required)
       ++lam->nrequired;
@@ -592,7 +591,7 @@ Node *Analyzer::analyze_let(Value x, SrcLoc loc, Scope *sc) {
     }
     if (inner.index_of(var.symbol()) >= 0)
       syntax_error(iloc, "Ill-formed special form: " + symbol_name(var) + " is bound twice in " +
-                             write_string(x));
+                             written(x));
     inner.vars.push_back(var.symbol());
     inits.push_back(init.is(Tag::Unassigned) ? const_node(init, iloc) : analyze(init, iloc, sc));
   }

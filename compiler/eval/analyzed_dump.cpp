@@ -1,14 +1,13 @@
 // The analyzed program as text (see analyzed_dump.hpp).
 #include "eval/analyzed_dump.hpp"
 
-#include "print/printer.hpp"
 
 namespace sicm {
 
 namespace {
 
 std::string name_of(const Node *n) {
-  return n->value.is(Tag::Symbol) ? n->value.symbol()->name : write_string(n->value);
+  return n->value.is(Tag::Symbol) ? n->value.symbol()->name : written(n->value);
 }
 
 std::string local(const Node *n) {
@@ -46,7 +45,7 @@ void dump(const Node *n, std::string &out) {
   switch (n->kind) {
   case NodeKind::Const: {
     bool self = !n->value.is(Tag::Symbol) && !n->value.is(Tag::Pair) && !n->value.is(Tag::Nil);
-    out += self ? write_string(n->value) : "(quote " + write_string(n->value) + ")";
+    out += self ? written(n->value) : "(quote " + written(n->value) + ")";
     return;
   }
   case NodeKind::LocalRef: out += local(n); return;

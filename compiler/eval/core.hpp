@@ -7,8 +7,6 @@
 
 namespace sicm {
 
-void install_core_primitives();
-void install_list_primitives();
 
 bool eqv(Value a, Value b);
 bool equal(Value a, Value b);

@@ -17,7 +17,6 @@
 #include "base/primitive.hpp"
 #include "eval/core.hpp"
 #include "eval/procedure.hpp"
-#include "print/printer.hpp"
 
 namespace sicm {
 
@@ -42,12 +41,12 @@ std::string plural(long n, const char *word) {
     requires_ = "at least " + plural(min, "argument");
   else
     requires_ = "between " + std::to_string(min) + " and " + plural(max, "argument");
-  runtime_error(loc, "The procedure " + write_string(proc) + " has been called with " +
+  runtime_error(loc, "The procedure " + written(proc) + " has been called with " +
                          plural(given, "argument") + "; it requires " + requires_ + ".");
 }
 
 [[noreturn]] void not_applicable(Value f, SrcLoc loc) {
-  runtime_error(loc, "The object " + write_string(f) + " is not applicable.");
+  runtime_error(loc, "The object " + written(f) + " is not applicable.");
 }
 
 // Bind evaluated arguments into a new frame for closure c.

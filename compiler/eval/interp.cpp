@@ -1,28 +1,14 @@
-// The interpreter's top level: start-up, whole-program checks, running a
-// source file form by form.
+// The interpreter's top level: whole-program checks, running a source file
+// form by form. (Start-up, which installs every layer's primitives, is
+// driver/init.cpp.)
 #include "eval/interp.hpp"
 
 #include <algorithm>
 #include <unordered_set>
 
-#include "algebra/differential.hpp"
-#include "algebra/generic.hpp"
-#include "algebra/operator.hpp"
-#include "algebra/series.hpp"
-#include "algebra/symbolic.hpp"
-#include "base/number.hpp"
-#include "builtins/builtins.hpp"
-#include "builtins/effects_used.hpp"
-#include "builtins/numerics.hpp"
-#include "builtins/parameter.hpp"
-#include "builtins/plot.hpp"
-#include "codegen/kernel.hpp"
 #include "eval/analyze.hpp"
 #include "eval/core.hpp"
 #include "eval/procedure.hpp"
-#include "eval/stdlib.hpp"
-#include "print/infix.hpp"
-#include "print/printer.hpp"
 #include "syntax/reader.hpp"
 
 namespace sicm {
@@ -66,38 +52,7 @@ std::string suggestion(const std::string &name, const std::vector<std::string> &
   return best;
 }
 
-void load_embedded_stdlib() {
-  for (const EmbeddedSource *s = embedded_stdlib(); s->name; ++s) {
-    uint32_t file = register_source(std::string("<stdlib>/") + s->name, s->text);
-    for (const ReadForm &f : read_all(file))
-      eval_toplevel(f.datum, f.loc);
-  }
-}
-
 } // namespace
-
-void init_interpreter() {
-  install_special_forms();
-  install_core_primitives();
-  install_list_primitives();
-  install_number_primitives();
-  install_text_primitives();
-  install_vector_primitives();
-  install_plot_primitives();
-  install_show_primitives();
-  install_algebra_primitives();
-  install_generic_primitives();
-  register_differential_arith();
-  install_operator_primitives();
-  install_literal_function_primitives();
-  install_series_primitives();
-  install_numerics_primitives();
-  install_kernel_primitives();
-  install_parameter_primitives();
-  install_effect_primitives();
-  load_embedded_stdlib();
-  set_first_user_file(register_source("<first user source>", "") + 1);
-}
 
 Value eval_toplevel(Value datum, SrcLoc loc) {
   Node *n = analyze_form(datum, loc, nullptr);
@@ -162,7 +117,7 @@ void run_source(uint32_t file) {
     Value v = eval(nodes[i], nullptr);
     if (is_printable_toplevel(f.datum, v)) {
       if (print_preparer()) v = print_preparer()(v);
-      output(write_string(v));
+      output(written(v));
       output("\n");
     }
   }

@@ -9,10 +9,6 @@
 
 namespace sicm {
 
-// Set up the global environment: every primitive, then the Scheme prelude.
-// Call once, after GC_INIT(), on the thread that will evaluate.
-void init_interpreter();
-
 // Analyze and evaluate one top-level form read from a source. Throws Error.
 Value eval_toplevel(Value datum, SrcLoc loc);
 

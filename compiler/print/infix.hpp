@@ -36,7 +36,6 @@ std::string datum_to_infix(Value datum);
 std::string datum_to_tex(Value datum);
 
 // show-expression, ->infix, ->tex-string (builtins/show.cpp).
-void install_show_primitives();
 
 // Shapes of prefix data that both renderers recognize (print/infix.cpp).
 namespace expr_shape {

@@ -1,6 +1,7 @@
 // Start the collector and the interpreter once for every unit test.
 #include <gtest/gtest.h>
 
+#include "driver/init.hpp"
 #include "eval/interp.hpp"
 
 namespace {

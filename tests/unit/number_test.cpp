@@ -7,6 +7,7 @@
 #include "base/error.hpp"
 #include "base/number.hpp"
 #include "base/primitive.hpp"
+#include "builtins/builtins.hpp"
 
 namespace sicm {
 namespace {

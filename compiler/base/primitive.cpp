@@ -1,0 +1,96 @@
+// Registering primitives and their argument errors (see primitive.hpp).
+#include "base/primitive.hpp"
+
+#include "base/error.hpp"
+
+namespace sicm {
+
+// ---- registration and argument errors --------------------------------------
+
+void define_primitive(const char *name, int min_args, int max_args, PrimFn fn) {
+  Primitive *p = gc_new<Primitive>(Primitive{name, min_args, max_args, fn});
+  define_global(name, Value::object(Tag::Primitive, p));
+}
+
+void define_global(const char *name, Value v) {
+  Symbol *s = intern(name).symbol();
+  s->global = v;
+  s->bound = true;
+}
+
+namespace {
+const char *ordinal(int n) {
+  static const char *const names[] = {"zeroth", "first",   "second", "third", "fourth", "fifth",
+                                      "sixth",  "seventh", "eighth", "ninth", "tenth"};
+  return n >= 0 && n <= 10 ? names[n] : "nth";
+}
+} // namespace
+
+namespace {
+
+RunTimeValueTest g_run_time_value_test = nullptr;
+
+// A primitive that only sicm run computes, given a value known only at run
+// time by sicm build.
+void refuse_run_time_argument(Value obj, int argpos, const char *who) {
+  if (!g_run_time_value_test || !g_run_time_value_test(obj)) return;
+  throw Error(ErrorKind::Syntax, current_call_loc(),
+              std::string("cannot compile: ") + who + " of a number known only at run time (its " +
+                  ordinal(argpos) + " argument)",
+              "sicm build leaves only numerical work for run time; `sicm run` interprets this "
+              "program");
+}
+
+} // namespace
+
+void set_run_time_value_test(RunTimeValueTest test) {
+  g_run_time_value_test = test;
+}
+
+RunTimeValueTest run_time_value_test() {
+  return g_run_time_value_test;
+}
+
+void wrong_type(Value obj, int argpos, const char *who) {
+  refuse_run_time_argument(obj, argpos, who);
+  runtime_error(current_call_loc(), "The object " + written(obj) + ", passed as the " +
+                                        ordinal(argpos) + " argument to " + who +
+                                        ", is not the correct type.");
+}
+
+void bad_range(Value obj, int argpos, const char *who) {
+  refuse_run_time_argument(obj, argpos, who);
+  runtime_error(current_call_loc(), "The object " + written(obj) + ", passed as the " +
+                                        ordinal(argpos) + " argument to " + who +
+                                        ", is not in the correct range.");
+}
+
+int64_t arg_fixnum(Value *args, int i, const char *who) {
+  if (!args[i].is(Tag::Fixnum)) wrong_type(args[i], i + 1, who);
+  return args[i].i;
+}
+
+size_t arg_index(Value *args, int i, const char *who) {
+  if (!args[i].is(Tag::Fixnum)) wrong_type(args[i], i + 1, who);
+  if (args[i].i < 0) bad_range(args[i], i + 1, who);
+  return static_cast<size_t>(args[i].i);
+}
+
+size_t arg_bounded(Value *args, int i, size_t lo, size_t hi, const char *who) {
+  if (!args[i].is(Tag::Fixnum)) wrong_type(args[i], i + 1, who);
+  if (args[i].i < 0 || static_cast<size_t>(args[i].i) < lo || static_cast<size_t>(args[i].i) > hi)
+    bad_range(args[i], i + 1, who);
+  return static_cast<size_t>(args[i].i);
+}
+
+std::string_view arg_string(Value *args, int i, const char *who) {
+  if (!args[i].is(Tag::String)) wrong_type(args[i], i + 1, who);
+  return string_view(args[i]);
+}
+
+Symbol *arg_symbol(Value *args, int i, const char *who) {
+  if (!args[i].is(Tag::Symbol)) wrong_type(args[i], i + 1, who);
+  return args[i].symbol();
+}
+
+} // namespace sicm
