@@ -40,8 +40,12 @@ struct Error : std::runtime_error {
 [[noreturn]] void syntax_error(SrcLoc loc, const std::string &msg);
 [[noreturn]] void runtime_error(SrcLoc loc, const std::string &msg);
 
-// The location of the call being evaluated, for errors raised by primitives.
+// Where evaluation is, for errors raised outside the evaluator's loop:
+// the call being evaluated (for errors raised by primitives), and where the
+// top-level form being run starts. The evaluator keeps both (eval/eval.cpp,
+// eval/interp.cpp).
 SrcLoc current_call_loc();
+SrcLoc current_toplevel_loc();
 
 // Print an error in compiler style on stream f (the source line and a caret
 // when the location is known).

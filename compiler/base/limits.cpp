@@ -48,8 +48,6 @@
 #include <fstream>
 
 #include "base/error.hpp"
-#include "cas/expr.hpp"
-#include "eval/interp.hpp"
 
 namespace sicm {
 
@@ -102,6 +100,12 @@ Limits g_limits = {kUnlimited,
                    kUnlimited,
                    kMaxUnrolledElements,
                    kMaxUnrolledIterations};
+NodeCounter g_node_counter = nullptr;
+
+size_t node_count() {
+  return g_node_counter ? g_node_counter() : 0;
+}
+
 bool g_compile_time = false;
 bool g_active = false; // set_limits has run
 uint64_t g_steps_base = 0;
@@ -400,15 +404,19 @@ void begin_evaluation(SrcLoc where) {
   g_grant = 0;
   limits_detail::fuel = 0;
   limits_detail::interrupt.store(0, std::memory_order_relaxed);
-  g_expr_base = expr_count();
+  g_expr_base = node_count();
   uint64_t max = g_limits.max_expression_nodes;
   limits_detail::expr_ceiling =
       max == kUnlimited || max > kUnlimited - g_expr_base ? kUnlimited : g_expr_base + max;
   reset_call_loc(where);
 }
 
+void set_expression_node_counter(NodeCounter count) {
+  g_node_counter = count;
+}
+
 ExpressionBudget::ExpressionBudget(uint64_t nodes) : saved_ceiling_(limits_detail::expr_ceiling) {
-  uint64_t now = expr_count();
+  uint64_t now = node_count();
   uint64_t ceiling = nodes > kUnlimited - now ? kUnlimited : now + nodes;
   limits_detail::expr_ceiling = std::min(saved_ceiling_, ceiling);
 }
@@ -421,7 +429,7 @@ void check_expression_growth(double terms, const char *what) {
   if (limits_detail::interrupt.load(std::memory_order_relaxed)) interrupted(somewhere());
   uint64_t ceiling = limits_detail::expr_ceiling;
   if (ceiling == kUnlimited) return;
-  double room = static_cast<double>(ceiling) - static_cast<double>(expr_count());
+  double room = static_cast<double>(ceiling) - static_cast<double>(node_count());
   if (terms < room) return;
   limit_error(somewhere(), "expression size limit (--max-expression-nodes=" +
                                show_count(g_limits.max_expression_nodes) + ") exceeded: " + what +

@@ -90,6 +90,11 @@ void note_residual_statement(SrcLoc where);
 // The limits in force (with defaults filled in), as set_limits set them.
 const Limits &current_limits();
 
+// How many nodes the expression arena holds (cas/expr.cpp's expr_count,
+// given at start-up by driver/init.cpp; until then none are counted).
+using NodeCounter = size_t (*)();
+void set_expression_node_counter(NodeCounter count);
+
 // Steps taken since the evaluation began (for tests and measurements).
 uint64_t steps_taken();
 

@@ -11,8 +11,10 @@
 #include "algebra/operator.hpp"
 #include "algebra/series.hpp"
 #include "algebra/symbolic.hpp"
+#include "base/limits.hpp"
 #include "base/value.hpp"
 #include "builtins/builtins.hpp"
+#include "cas/expr.hpp"
 #include "eval/analyze.hpp"
 #include "eval/interp.hpp"
 #include "eval/procedure.hpp"
@@ -36,6 +38,7 @@ void load_embedded_stdlib() {
 
 void init_interpreter() {
   set_value_writer(write_string);
+  set_expression_node_counter(expr_count);
   install_special_forms();
   install_core_primitives();
   install_list_primitives();

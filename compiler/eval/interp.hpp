@@ -26,9 +26,6 @@ void run_source(uint32_t file);
 // Returns the analyzed forms, in order, ready to evaluate.
 gcvec<struct Node *> check_program(const gcvec<struct ReadForm> &forms);
 
-// Where the top-level form being evaluated by run_source starts.
-SrcLoc current_toplevel_loc();
-
 // The names bound in the global environment (for REPL completion).
 std::vector<std::string> global_names();
 
