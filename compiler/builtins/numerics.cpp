@@ -52,7 +52,6 @@
 #include "builtins/numerics_defaults.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/procedure.hpp"
-#include "pe/build.hpp"
 #include "print/printer.hpp"
 #include "sicm/runtime.h"
 
@@ -594,11 +593,13 @@ bool kernels_enabled() {
   return enabled;
 }
 
+ScalarCompiler g_scalar_compiler = nullptr;
+
 void compile_expensive(ScalarCallback &cb) {
   cb.compile_tried = true;
   if (!kernels_enabled() || g_auto_kernels >= kMaxAutoKernels) return;
   std::string why_not;
-  cb.compiled = compile_for_run(cb.f, cb.who, &why_not);
+  cb.compiled = g_scalar_compiler ? g_scalar_compiler(cb.f, cb.who, &why_not) : nullptr;
   if (cb.compiled) ++g_auto_kernels;
 }
 
@@ -1176,6 +1177,10 @@ void install_numerics_primitives() {
   define_primitive("evolve", 1, kVariadic, P_evolve);
   define_primitive("eigenvalues", 1, 1, P_eigenvalues);
   define_primitive("matrix->eigenvalues", 1, 1, P_eigenvalues);
+}
+
+void set_scalar_compiler(ScalarCompiler compiler) {
+  g_scalar_compiler = compiler;
 }
 
 } // namespace sicm

@@ -4,7 +4,24 @@
 // the runtime's numerical modules (runtime/include/sicm/*.h).
 #pragma once
 
+#include <string>
+
+#include "base/value.hpp"
+
 namespace sicm {
 
+// A procedure of one real compiled for sicm run: writes f(in[0]) to out[0]
+// and returns 0, or returns 1 where the interpreter must compute the value
+// (a checked operation would leave the reals: division by zero, the square
+// root of a negative number).
+using CompiledScalarFn = int (*)(const double *in, double *out);
+
+// What compiles bisect's function when one interpreted call proves
+// expensive: f compiled and loaded, or null with the reason in *why_not.
+// sicm build's partial evaluator provides it (pe/for_run.cpp's
+// compile_for_run, given at start-up by driver/init.cpp); without one, the
+// function is interpreted.
+using ScalarCompiler = CompiledScalarFn (*)(Value f, const char *who, std::string *why_not);
+void set_scalar_compiler(ScalarCompiler compiler);
 
 } // namespace sicm

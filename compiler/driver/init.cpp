@@ -14,11 +14,13 @@
 #include "base/limits.hpp"
 #include "base/value.hpp"
 #include "builtins/builtins.hpp"
+#include "builtins/numerics.hpp"
 #include "cas/expr.hpp"
 #include "eval/analyze.hpp"
 #include "eval/interp.hpp"
 #include "eval/procedure.hpp"
 #include "eval/stdlib.hpp"
+#include "pe/build.hpp"
 #include "print/printer.hpp"
 #include "syntax/reader.hpp"
 
@@ -39,6 +41,7 @@ void load_embedded_stdlib() {
 void init_interpreter() {
   set_value_writer(write_string);
   set_expression_node_counter(expr_count);
+  set_scalar_compiler(compile_for_run);
   install_special_forms();
   install_core_primitives();
   install_list_primitives();

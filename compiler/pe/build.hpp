@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "builtins/numerics.hpp"
 #include "codegen/residual.hpp"
 
 namespace sicm {
@@ -35,17 +36,12 @@ private:
 // Is a build going on (a BuildSession alive)?
 bool in_build_mode();
 
-// A procedure of one real compiled for sicm run: writes f(in[0]) to out[0]
-// and returns 0, or returns 1 where the interpreter must compute the value
-// (a checked operation would leave the reals: division by zero, the square
-// root of a negative number).
-using CompiledScalarFn = int (*)(const double *in, double *out);
-
 // sicm run: f (a procedure of one real returning a real) compiled by the
 // partial evaluator and loaded, or null with the reason in *why_not when it
 // cannot be (it has effects, calls numerical primitives, or no C compiler
 // works). The interpreter's heap is as it was either way. who: the
 // primitive that asks (for messages). See pe/for_run.cpp.
+// Given to the numerical primitives at start-up (set_scalar_compiler).
 CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not);
 
 } // namespace sicm
