@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/integration_sites.hpp"
+#include "builtins/integration_sites.hpp"
 #include "builtins/numerics_defaults.hpp"
 #include "sicm/runtime.h"
 

@@ -48,7 +48,7 @@
 #include "base/limits.hpp"
 #include "base/number.hpp"
 #include "base/primitive.hpp"
-#include "bench/integration_sites.hpp"
+#include "builtins/integration_sites.hpp"
 #include "builtins/numerics_defaults.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/procedure.hpp"

@@ -15,8 +15,8 @@
 
 #include "base/error.hpp"
 #include "base/limits.hpp"
-#include "bench/integration_sites.hpp"
 #include "bench/work_precision.hpp"
+#include "builtins/integration_sites.hpp"
 #include "builtins/numerics_defaults.hpp"
 #include "builtins/parameter.hpp"
 #include "builtins/plot.hpp"

@@ -1,5 +1,5 @@
 // The integrations a program performs, one per site (see integration_sites.hpp).
-#include "bench/integration_sites.hpp"
+#include "builtins/integration_sites.hpp"
 
 namespace sicm {
 
