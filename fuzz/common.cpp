@@ -14,6 +14,7 @@
 #include "base/limits.hpp"
 #include "base/number.hpp"
 #include "base/value.hpp"
+#include "cas/expr.hpp"
 #include "eval/procedure.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -104,6 +105,7 @@ void limit_expression_nodes(uint64_t nodes) {
   limits.max_expression_nodes = nodes;
   limits.max_steps = sicm::kUnlimited;
   limits.max_memory = sicm::kUnlimited; // libFuzzer's -rss_limit_mb watches memory
+  sicm::set_expression_node_counter(sicm::expr_count);
   sicm::set_limits(limits, false);
 }
 

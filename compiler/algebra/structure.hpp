@@ -20,17 +20,6 @@
 
 namespace sicm {
 
-struct Structure {
-  bool up;
-  Value *items; // GC memory, `len` components
-  size_t len;
-};
-
-struct Matrix {
-  size_t rows, cols;
-  Value *items; // GC memory, row-major: entry (i, j) is items[i * cols + j]
-};
-
 // ---- construction and access ----
 // A structure of len components, each initialized to #!unspecific; fill it
 // before it escapes.

@@ -381,6 +381,8 @@ size_t evaluator_stack_bytes(const Limits &limits) {
 }
 
 void set_limits(const Limits &limits, bool compile_time) {
+  // Without the arena's counter the expression limit would count from zero.
+  SICM_ASSERT(g_node_counter);
   g_limits = with_defaults(limits, compile_time);
   g_compile_time = compile_time;
   if (!g_active) {

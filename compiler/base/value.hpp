@@ -207,6 +207,19 @@ struct Vector {
   uint32_t serial = g_frame_serial;
 };
 
+// SICM's up and down tuples and matrices (their operations are
+// algebra/structure.hpp's).
+struct Structure {
+  bool up;
+  Value *items; // GC memory, `len` components
+  size_t len;
+};
+
+struct Matrix {
+  size_t rows, cols;
+  Value *items; // GC memory, row-major: entry (i, j) is items[i * cols + j]
+};
+
 struct Promise {
   bool forced;
   Value value;       // the value once forced

@@ -12,7 +12,6 @@
 // also notices Ctrl-C in the REPL (base/limits.hpp).
 #include <string>
 
-#include "algebra/structure.hpp"
 #include "base/limits.hpp"
 #include "base/primitive.hpp"
 #include "eval/core.hpp"

@@ -113,3 +113,40 @@ TEST(Docs, ArchitectureListsEverySourceFile) {
   }
   EXPECT_GT(checked, 100);
 }
+
+// The folders of the compiler are layers, in the order ARCHITECTURE.md lists
+// them: no file includes a header of a folder listed after its own.
+TEST(Docs, NoFolderIncludesALaterOne) {
+  if (!in_repository_root()) GTEST_SKIP() << "not run from the repository root";
+  std::ifstream in("ARCHITECTURE.md");
+  ASSERT_TRUE(in) << "ARCHITECTURE.md is missing";
+  std::vector<std::string> order;
+  const std::string heading = "### `compiler/";
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(heading, 0) == 0)
+      order.push_back(line.substr(heading.size(), line.find('/', heading.size()) - heading.size()));
+  ASSERT_GE(order.size(), 8u);
+  auto rank = [&](const std::string &folder) -> int {
+    for (size_t i = 0; i < order.size(); ++i)
+      if (order[i] == folder) return static_cast<int>(i);
+    return -1;
+  };
+  int checked = 0;
+  for (const auto &entry : std::filesystem::recursive_directory_iterator("compiler")) {
+    const std::string ext = entry.path().extension().string();
+    if (!entry.is_regular_file() || (ext != ".cpp" && ext != ".hpp")) continue;
+    std::string folder = entry.path().parent_path().filename().string();
+    int own = rank(folder);
+    EXPECT_GE(own, 0) << folder << " is not a section of ARCHITECTURE.md";
+    std::ifstream file(entry.path());
+    for (std::string line; std::getline(file, line);) {
+      if (line.rfind("#include \"", 0) != 0) continue;
+      std::string included = line.substr(10, line.find('/', 10) - 10);
+      int theirs = rank(included);
+      EXPECT_FALSE(theirs > own) << entry.path().string() << " includes " << line.substr(9)
+                                 << ", of a later layer";
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 300);
+}
