@@ -1,6 +1,7 @@
 // What number.cpp (the numeric tower) shares with complex.cpp (its complex
-// numbers) and builtins/number.cpp (its primitives) and no one else: scoped
-// GMP integers, argument checks, the comparison and integer division that
+// numbers), number_text.cpp (reading and writing them) and
+// builtins/number.cpp (its primitives) and no one else: scoped GMP integers
+// and rationals, argument checks, the comparison and integer division that
 // MIT's primitives are written over, and the complex operations.
 #pragma once
 
@@ -22,8 +23,28 @@ struct Z {
   operator mpz_srcptr() const { return v; }
 };
 
+// A scoped mpq.
+struct Q {
+  mpq_t v;
+  Q() { mpq_init(v); }
+  ~Q() { mpq_clear(v); }
+  Q(const Q &) = delete;
+  Q &operator=(const Q &) = delete;
+  operator mpq_ptr() { return v; }
+  operator mpq_srcptr() const { return v; }
+};
+
 inline mpz_srcptr big(Value v) {
   return v.as<Bignum>()->z;
+}
+
+inline mpq_srcptr rat(Value v) {
+  return v.as<Ratnum>()->q;
+}
+
+// The integer a flonum holds (it must be integral and finite).
+inline void flonum_to_mpz(double d, mpz_ptr z) {
+  mpz_set_d(z, d);
 }
 
 inline bool is_flonum(Value v) {
