@@ -275,8 +275,12 @@ Value make_rational(const mpq_t q) {
   Q c;
   mpq_set(c, q);
   mpq_canonicalize(c);
-  if (mpz_cmp_ui(mpq_denref(c.v), 1) == 0) return make_integer(mpq_numref(c.v));
-  return box_ratnum(c);
+  return make_canonical_rational(c);
+}
+
+Value make_canonical_rational(mpq_srcptr q) {
+  if (mpz_cmp_ui(mpq_denref(q), 1) == 0) return make_integer(mpq_numref(q));
+  return box_ratnum(q);
 }
 
 Value make_integer_from_string(std::string_view digits, int radix) {
@@ -644,7 +648,9 @@ Value exact_integer_expt(Value b, Value e) {
   mpz_pow_ui(mpq_numref(out.v), mpq_numref(base.v), n);
   mpz_pow_ui(mpq_denref(out.v), mpq_denref(base.v), n);
   if (negative) mpq_inv(out, out);
-  return make_rational(out);
+  // Powers of coprime integers are coprime: the result is canonical as it
+  // is, and canonicalizing a power of millions of bits (a gcd) took minutes.
+  return make_canonical_rational(out);
 }
 
 // The exact k-th root of a positive exact rational, if there is one.

@@ -47,6 +47,8 @@ bool is_recnum(Value v);         // a complex number that is not real
 // ---- construction ----
 Value make_integer(const mpz_t z);  // normalizes to fixnum when it fits
 Value make_rational(const mpq_t q); // q need not be canonical; normalizes
+// q must be canonical: no gcd (which for millions of bits takes minutes).
+Value make_canonical_rational(mpq_srcptr q);
 Value make_integer_from_string(std::string_view digits, int radix = 10);
 double to_double(Value v); // any number -> nearest double
 // Exact integer value as int64 if it fits; nullopt otherwise (or if not an exact integer).

@@ -117,11 +117,7 @@ bool arity_ok(Op op, size_t n) {
 
 // ---- construction --------------------------------------------------------
 
-ExprId expr_rational(mpq_srcptr q_in) {
-  mpq_t q;
-  mpq_init(q);
-  mpq_set(q, q_in);
-  mpq_canonicalize(q);
+ExprId expr_canonical_rational(mpq_srcptr q) {
   uint32_t h = mix(hash_mpq(q), static_cast<uint64_t>(ExprKind::Rational));
   ExprId id = intern_node(
       h,
@@ -139,6 +135,15 @@ ExprId expr_rational(mpq_srcptr q_in) {
         g_rats.push_back(owned);
         return push_node(n);
       });
+  return id;
+}
+
+ExprId expr_rational(mpq_srcptr q_in) {
+  mpq_t q;
+  mpq_init(q);
+  mpq_set(q, q_in);
+  mpq_canonicalize(q);
+  ExprId id = expr_canonical_rational(q);
   mpq_clear(q);
   return id;
 }
@@ -243,10 +248,12 @@ ExprId expr_from_number(Value v) {
                       "real numbers");
   if (v.is(Tag::Fixnum)) return expr_integer(v.i);
   SICM_ASSERT(is_exact_rational(v));
+  // A number of the tower is canonical already (and canonicalizing one of
+  // millions of bits is a gcd that takes minutes).
   mpq_t q;
   mpq_init(q);
   to_mpq(v, q);
-  ExprId id = expr_rational(q);
+  ExprId id = expr_canonical_rational(q);
   mpq_clear(q);
   return id;
 }
@@ -295,7 +302,7 @@ Value expr_number_value(ExprId id) {
   const ExprNode &n = expr_node(id);
   if (n.kind == ExprKind::Flonum) return Value::flonum(n.d);
   SICM_ASSERT(n.kind == ExprKind::Rational);
-  return make_rational(expr_rat(id));
+  return make_canonical_rational(expr_rat(id)); // the arena's rationals are canonical
 }
 
 int expr_number_sign(ExprId id) {

@@ -115,6 +115,9 @@ struct ExprNode {
 
 // ---- construction (hash-consed; no rewriting: callers build what they mean) ----
 ExprId expr_rational(mpq_srcptr q); // q need not be canonical
+// q must be canonical (as the tower's numbers and FLINT's rationals are): no
+// gcd, which for a number of millions of bits takes minutes.
+ExprId expr_canonical_rational(mpq_srcptr q);
 ExprId expr_integer(int64_t n);
 ExprId expr_flonum(double d);
 ExprId expr_symbol(Symbol *s);

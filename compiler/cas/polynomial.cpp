@@ -485,7 +485,7 @@ double coefficient_double(const fmpq_t c) {
 
 ExprId coefficient_expr(const fmpq_t c, bool inexact) {
   if (inexact) return expr_flonum(coefficient_double(c));
-  return expr_rational(GmpRational(c).q);
+  return expr_canonical_rational(GmpRational(c).q); // FLINT's rationals are canonical
 }
 
 // The canonical expression of p, its coefficients first multiplied by `scale`.
