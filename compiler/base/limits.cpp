@@ -438,6 +438,13 @@ void check_expression_growth(double terms, const char *what) {
                                " could have up to " + show_estimate(terms) + " terms");
 }
 
+static_assert(sizeof(std::atomic<int>) == sizeof(int) && std::atomic<int>::is_always_lock_free,
+              "compiled code reads the interrupt request as an int");
+
+const volatile int *interrupt_flag() {
+  return reinterpret_cast<const volatile int *>(&limits_detail::interrupt);
+}
+
 void request_interrupt() {
   limits_detail::interrupt.store(1, std::memory_order_relaxed);
 }

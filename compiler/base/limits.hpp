@@ -83,6 +83,10 @@ void begin_evaluation(SrcLoc where);
 // every check after it until begin_evaluation.
 void request_interrupt();
 
+// The interrupt request as a plain int, for compiled loops to poll (see
+// codegen/residual_emit.hpp emit_residual_function).
+const volatile int *interrupt_flag();
+
 // sicm build: one more statement in the residual program, emitted at
 // `where`; raises the residual size error past the limit.
 void note_residual_statement(SrcLoc where);

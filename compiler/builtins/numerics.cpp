@@ -213,7 +213,7 @@ double call_scalar(double x, void *data) {
     double v;
     if (cb->kernel) {
       kernel_call(cb->kernel, &x, &v);
-    } else if (!cb->compiled || cb->compiled(&x, &v) != 0) {
+    } else if (!cb->compiled || cb->compiled(&x, &v, interrupt_flag()) != 0) {
       uint64_t steps = steps_taken();
       Value arg = Value::flonum(x);
       Value r = apply_procedure(cb->f, &arg, 1);

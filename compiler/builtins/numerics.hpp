@@ -13,8 +13,8 @@ namespace sicm {
 // A procedure of one real compiled for sicm run: writes f(in[0]) to out[0]
 // and returns 0, or returns 1 where the interpreter must compute the value
 // (a checked operation would leave the reals: division by zero, the square
-// root of a negative number).
-using CompiledScalarFn = int (*)(const double *in, double *out);
+// root of a negative number; or *interrupt became nonzero in a loop).
+using CompiledScalarFn = int (*)(const double *in, double *out, const volatile int *interrupt);
 
 // What compiles bisect's function when one interpreted call proves
 // expensive: f compiled and loaded, or null with the reason in *why_not.

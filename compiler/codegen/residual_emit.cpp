@@ -115,6 +115,7 @@ public:
 
   // Function f alone, for sicm run to load (see emit_residual_function).
   std::string emit_function(int f, const std::string &entry) {
+    for_run_ = true;
     for (int g = static_cast<int>(p_.functions.size()) - 1; g >= 0; --g)
       analyze(g);
     SICM_ASSERT(captures_[f].empty()); // the caller checked that f is the only function
@@ -128,9 +129,9 @@ public:
     out += "\nstatic void f" + std::to_string(f) +
            "(const double *in, double *out, const double *p);\n\n";
     out += code;
-    out += "int " + entry + "(const double *in, double *out) {\n" +
-           "  if (setjmp(sicm_escape)) return 1;\n  f" + std::to_string(f) +
-           "(in, out, NULL);\n  return 0;\n}\n";
+    out += "int " + entry + "(const double *in, double *out, const volatile int *interrupt) {\n" +
+           "  sicm_interrupt = interrupt;\n  if (setjmp(sicm_escape)) return 1;\n  f" +
+           std::to_string(f) + "(in, out, NULL);\n  return 0;\n}\n";
     return out;
   }
 
@@ -145,6 +146,9 @@ private:
   int col;
 } sicm_site;
 static _Thread_local jmp_buf sicm_escape;
+/* Nonzero when the user asks to interrupt (Ctrl-C in the REPL): every loop
+   gives up, and the interpreter raises "Interrupted" as it would. */
+static _Thread_local const volatile int *sicm_interrupt;
 static double sicm_checked_quotient(const sicm_site *site, const char *who, double a, double b) {
   (void)site;
   (void)who;
@@ -748,6 +752,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
           init += var_name(s.outs[i]) + " = " + a[i] + ";\n";
         code += indent(init, depth);
         code += indent("for (;;) {", depth);
+        if (for_run_) code += indent("if (*sicm_interrupt) longjmp(sicm_escape, 1);", depth + 1);
         code += block(f, s.then_body, depth + 1);
         code += indent("}", depth);
         for (int v : s.outs) // a loop variable that only its own update reads
@@ -813,6 +818,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
   }
 
   const ResidualProgram &p_;
+  bool for_run_ = false; // emit_function: loops poll sicm_interrupt
   std::vector<std::set<int>> captures_;
   std::set<const RStmt *> dropped_;
   std::map<int, std::set<int>> used_, hoisted_;

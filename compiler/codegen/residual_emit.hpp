@@ -17,10 +17,11 @@ std::string emit_residual_program(const ResidualProgram &program);
 
 // Function `function` of the program (which calls no other and captures
 // nothing) as a C11 unit for sicm run to load: it needs no runtime, and
-// defines int ENTRY(const double *in, double *out), which computes the
-// function and returns 0, or returns 1 where one of the program's checked
-// operations (a division by zero, a square root of a negative number) would
-// fail, leaving the value to the interpreter. See pe/for_run.cpp.
+// defines int ENTRY(const double *in, double *out, const volatile int
+// *interrupt), which computes the function and returns 0, or returns 1 where
+// one of the program's checked operations (a division by zero, a square
+// root of a negative number) would fail or *interrupt becomes nonzero in a
+// loop, leaving the value to the interpreter. See pe/for_run.cpp.
 std::string emit_residual_function(const ResidualProgram &program, int function,
                                    const std::string &entry);
 

@@ -132,8 +132,8 @@ bool only_arithmetic(const std::vector<RStmt> &body) {
 // Does the C call anything named sicm_ that its own prelude does not define?
 bool calls_runtime(const std::string &c) {
   static const char *const kOwn[] = {
-      "sicm_site",  "sicm_escape", "sicm_checked_", "sicm_singular_nan",
-      "sicm_ldlt_", "sicm_lu_",    kEntry};
+      "sicm_site",         "sicm_escape", "sicm_interrupt", "sicm_checked_",
+      "sicm_singular_nan", "sicm_ldlt_",  "sicm_lu_",       kEntry};
   for (size_t at = c.find("sicm_"); at != std::string::npos; at = c.find("sicm_", at + 1)) {
     bool own = false;
     for (const char *name : kOwn)

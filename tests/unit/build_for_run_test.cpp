@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "base/limits.hpp"
 #include "base/number.hpp"
 #include "eval/interp.hpp"
 #include "eval/procedure.hpp"
@@ -32,7 +33,7 @@ CompiledScalarFn compile(const std::string &proc, std::string *why) {
 
 double call(CompiledScalarFn fn, double x) {
   double out = NAN;
-  EXPECT_EQ(fn(&x, &out), 0) << "at " << x;
+  EXPECT_EQ(fn(&x, &out, interrupt_flag()), 0) << "at " << x;
   return out;
 }
 
@@ -62,14 +63,29 @@ TEST(CompileForRun, CheckedOperationLeavesTheValueToTheInterpreter) {
   CompiledScalarFn fn = compile("(lambda (x) (/ 1. (- x 2.)))", &why);
   ASSERT_NE(fn, nullptr) << why;
   double x = 2.0, out = 0;
-  EXPECT_EQ(fn(&x, &out), 1); // division by zero: the interpreter raises it
+  EXPECT_EQ(fn(&x, &out, interrupt_flag()), 1); // division by zero: the interpreter raises it
   x = 3.0;
-  EXPECT_EQ(fn(&x, &out), 0);
+  EXPECT_EQ(fn(&x, &out, interrupt_flag()), 0);
   EXPECT_EQ(out, 1.0);
   fn = compile("(lambda (x) (sqrt x))", &why);
   ASSERT_NE(fn, nullptr) << why;
   x = -1.0;
-  EXPECT_EQ(fn(&x, &out), 1); // a complex number
+  EXPECT_EQ(fn(&x, &out, interrupt_flag()), 1); // a complex number
+}
+
+TEST(CompileForRun, InterruptEndsACompiledLoop) {
+  // A loop that never ends: Ctrl-C (in the REPL) must still stop it.
+  std::string why;
+  CompiledScalarFn fn =
+      compile("(lambda (x) (let loop ((y x)) (if (< y 0.) y (loop (+ y 1.)))))", &why);
+  ASSERT_NE(fn, nullptr) << why;
+  request_interrupt();
+  double x = 1.0, out = 0;
+  EXPECT_EQ(fn(&x, &out, interrupt_flag()), 1); // given up: the interpreter raises "Interrupted"
+  begin_evaluation(SrcLoc{});                   // forgets the request
+  x = -1.0;
+  EXPECT_EQ(fn(&x, &out, interrupt_flag()), 0);
+  EXPECT_EQ(out, -1.0);
 }
 
 TEST(CompileForRun, AssignmentOfAnOuterVariableIsRefusedAndNotDone) {
