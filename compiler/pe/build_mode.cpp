@@ -1,7 +1,8 @@
 // `sicm build`: the evaluator's primitives and hooks that turn a run into a
 // residual program (see codegen/residual.hpp for the idea).
 //
-// begin_build_mode() rebinds the primitives whose meaning changes: the
+// A BuildSession (begin_build_mode, below) rebinds the primitives whose
+// meaning changes, until it ends (end_build_mode puts them back): the
 // numerical primitives record a statement and return fresh run-time values;
 // plots record their statements; comparisons, floor, max and min of run-time
 // values become statements; printing names the run-time values it prints.
@@ -36,17 +37,20 @@
 //                                itself more often.
 //
 // The code is in these files, which share what pe/state.hpp declares:
-//   pe/build_mode.cpp   run-time values, statements, cells, output, the
-//                        rebound primitives and begin_build_mode (this file)
-//   pe/numerics.cpp   tracing procedures into functions; the numerical
-//                        primitives (integrals, minimizers, roots, state
-//                        advancers, evolve)
-//   pe/plots.cpp      frame, plot-point, plot-line, graphics-close
-//   pe/branches.cpp   tests on run-time values (if, and, or) and set!
-//   pe/loops.cpp      loops left for run time: named procedures called
-//                        again with run-time arguments, generalization past
-//                        the unroll limits, loops that start from known values
-//   pe/lists.cpp      lists whose length is known only at run time
+//   build_mode.cpp  run-time values, statements, cells, output, the rebound
+//                   primitives and BuildSession (this file)
+//   numerics.cpp    tracing procedures into functions; the numerical
+//                   primitives (integrals, minimizers, roots, state
+//                   advancers, evolve)
+//   plots.cpp       frame, plot-point, plot-line, graphics-close
+//   branches.cpp    tests on run-time values (if, and, or), set!, and the
+//                   mutations a traced procedure may not make
+//   loops.cpp       loops left for run time: named procedures called again
+//                   with run-time arguments, generalization past the unroll
+//                   limits, loops that start from known values
+//   lists.cpp       lists whose length is known only at run time
+//   parallel.cpp    parallel-map and parallel-for-each
+//   for_run.cpp     sicm run's use of all this: bisect's function compiled
 #include "pe/build.hpp"
 
 #include <algorithm>
