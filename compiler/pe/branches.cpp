@@ -284,37 +284,39 @@ namespace {
                              "runs once, while compiling)");
 }
 
-// Refuse who's mutation of v if v (a pair of the list it starts, a vector,
-// a string) was made before the innermost traced procedure was called.
+// Refuse who's change of v (a pair, a vector or a string) if v was made
+// before the innermost traced procedure was called.
 void check_owned(Value v, const char *who) {
   if (g_build->open.size() <= 1) return;
   uint32_t start = g_build->function_serials.back();
   if (v.is(Tag::Vector) && !made_since(v.vector()->serial, start)) refuse_outer(who, "a vector");
-  if (v.is(Tag::String)) refuse_outer(who, "a string");
-  for (long n = 0; is_pair(v) && n < 1000000; v = cdr(v), ++n)
-    if (!made_since(v.pair()->serial, start)) refuse_outer(who, "a pair");
+  if (v.is(Tag::Pair) && !made_since(v.pair()->serial, start)) refuse_outer(who, "a pair");
+  if (v.is(Tag::String)) refuse_outer(who, "a string"); // strings keep no serial
 }
 
-template <const char *Name, int Arg, bool AllButLast> Value P_owned(Value *a, int n) {
-  if (AllButLast) {
-    for (int i = 0; i + 1 < n; ++i)
-      check_owned(a[i], Name);
-  } else if (Arg < n) {
-    check_owned(a[Arg], Name);
-  }
+// set-car!, vector-set!, ...: the first argument is what changes.
+template <const char *Name> Value P_changes_first(Value *a, int n) {
+  if (n > 0) check_owned(a[0], Name);
   return call_original(Name, a, n);
 }
+
+// append! changes the last pair of each list but the last.
+Value P_append_bang(Value *a, int n) {
+  for (int i = 0; i + 1 < n && g_build->open.size() > 1; ++i) {
+    Value last = a[i];
+    for (long k = 0; is_pair(last) && is_pair(cdr(last)) && k < 100000000; ++k)
+      last = cdr(last);
+    check_owned(last, "append!");
+  }
+  return call_original("append!", a, n);
+}
+
 constexpr char kSetCar[] = "set-car!";
 constexpr char kSetCdr[] = "set-cdr!";
 constexpr char kVectorSet[] = "vector-set!";
 constexpr char kVectorFill[] = "vector-fill!";
 constexpr char kVectorCopy[] = "vector-copy!";
-constexpr char kAppendBang[] = "append!";
 constexpr char kStringSet[] = "string-set!";
-
-} // namespace
-
-namespace {
 
 Value P_with_output_to_string(Value *a, int n) {
   g_build->capture_depths.push_back(g_build->open.size());
@@ -346,13 +348,13 @@ void hook_forcing(Value promise) {
 }
 
 void rebind_mutators() {
-  rebind(kSetCar, 2, 2, P_owned<kSetCar, 0, false>);
-  rebind(kSetCdr, 2, 2, P_owned<kSetCdr, 0, false>);
-  rebind(kVectorSet, 3, 3, P_owned<kVectorSet, 0, false>);
-  rebind(kVectorFill, 2, kVariadic, P_owned<kVectorFill, 0, false>);
-  rebind(kVectorCopy, 3, 5, P_owned<kVectorCopy, 0, false>);
-  rebind(kAppendBang, 0, kVariadic, P_owned<kAppendBang, 0, true>);
-  rebind(kStringSet, 3, 3, P_owned<kStringSet, 0, false>);
+  rebind(kSetCar, 2, 2, P_changes_first<kSetCar>);
+  rebind(kSetCdr, 2, 2, P_changes_first<kSetCdr>);
+  rebind(kVectorSet, 3, 3, P_changes_first<kVectorSet>);
+  rebind(kVectorFill, 2, kVariadic, P_changes_first<kVectorFill>);
+  rebind(kVectorCopy, 3, 5, P_changes_first<kVectorCopy>);
+  rebind(kStringSet, 3, 3, P_changes_first<kStringSet>);
+  rebind("append!", 0, kVariadic, P_append_bang);
   rebind("with-output-to-string", 0, 1, P_with_output_to_string);
 }
 

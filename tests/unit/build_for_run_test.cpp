@@ -110,6 +110,20 @@ TEST(CompileForRun, MutationOutputAndPromisesAreRefusedAndNotDone) {
   EXPECT_EQ(compile("(lambda (x) (+ x (random 1.)))", &why), nullptr);
 }
 
+TEST(CompileForRun, OnlyWhatTheProcedureMadeMayChange) {
+  run("(define outer (list 1 2))");
+  std::string why;
+  EXPECT_EQ(compile("(lambda (x) (set-car! outer x) x)", &why), nullptr);
+  EXPECT_EQ(write_string(run("outer")), "(1 2)");
+  EXPECT_EQ(compile("(lambda (x) (append! outer (list x)) x)", &why), nullptr);
+  EXPECT_EQ(write_string(run("outer")), "(1 2)");
+  // A pair it makes, even one whose tail is an outer list, it may change.
+  CompiledScalarFn fn =
+      compile("(lambda (x) (let ((p (cons 0. outer))) (set-car! p x) (* 2. (car p))))", &why);
+  ASSERT_NE(fn, nullptr) << why;
+  EXPECT_EQ(call(fn, 3.0), 6.0);
+}
+
 TEST(CompileForRun, TheInterpreterIsItselfAfterwards) {
   std::string why;
   EXPECT_EQ(compile("(lambda (x) (display x) x)", &why), nullptr);
