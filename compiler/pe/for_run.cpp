@@ -158,22 +158,25 @@ CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not)
   }
   ResidualProgram program;
   int id = -1;
-  const SrcLoc call = current_call_loc(); // the trace moves it into the procedure
-  try {
-    TraceForRun build;
-    id = trace_scalar(f, who);
-    program = std::move(build.program());
-  } catch (const Error &e) {
-    reset_call_loc(call);
-    if (std::string_view(e.what()) == "Interrupted") throw;
-    *why_not = e.what();
-    return nullptr;
-  } catch (...) { // an escape from the procedure: it will escape when interpreted, too
-    reset_call_loc(call);
-    *why_not = "the procedure escapes";
-    return nullptr;
+  {
+    // The trace moves the evaluator's current call into the procedure.
+    struct KeepCallLoc {
+      SrcLoc call = current_call_loc();
+      ~KeepCallLoc() { reset_call_loc(call); }
+    } keep;
+    try {
+      TraceForRun build;
+      id = trace_scalar(f, who);
+      program = std::move(build.program());
+    } catch (const Error &e) {
+      if (std::string_view(e.what()) == "Interrupted") throw;
+      *why_not = e.what();
+      return nullptr;
+    } catch (...) { // an escape from the procedure: it will escape when interpreted, too
+      *why_not = "the procedure escapes";
+      return nullptr;
+    }
   }
-  reset_call_loc(call);
   program.source_name = procedure_name(f);
   if (program.functions.size() != 2 || !program.functions[0].body.empty() ||
       !program.cells.empty() || !program.lists.empty() || program.plots != 0 ||
