@@ -13,6 +13,7 @@
 #include "base/number.hpp"
 #include "eval/core.hpp"
 #include "eval/procedure.hpp"
+#include "pe/specialized.hpp"
 #include "pe/state.hpp"
 
 namespace sicm::build {
@@ -347,15 +348,12 @@ void hook_forcing(Value promise) {
     refuse_outer("forcing", "a promise");
 }
 
-void rebind_mutators() {
-  rebind(kSetCar, 2, 2, P_changes_first<kSetCar>);
-  rebind(kSetCdr, 2, 2, P_changes_first<kSetCdr>);
-  rebind(kVectorSet, 3, 3, P_changes_first<kVectorSet>);
-  rebind(kVectorFill, 2, kVariadic, P_changes_first<kVectorFill>);
-  rebind(kVectorCopy, 3, 5, P_changes_first<kVectorCopy>);
-  rebind(kStringSet, 3, 3, P_changes_first<kStringSet>);
-  rebind("append!", 0, kVariadic, P_append_bang);
-  rebind("with-output-to-string", 0, 1, P_with_output_to_string);
-}
+// What this file specializes (the table is pe/specialized.cpp).
+const PrimFn p_set_car = P_changes_first<kSetCar>, p_set_cdr = P_changes_first<kSetCdr>,
+             p_vector_set = P_changes_first<kVectorSet>,
+             p_vector_fill = P_changes_first<kVectorFill>,
+             p_vector_copy = P_changes_first<kVectorCopy>,
+             p_string_set = P_changes_first<kStringSet>, p_append_bang = P_append_bang,
+             p_with_output_to_string = P_with_output_to_string;
 
 } // namespace sicm::build

@@ -37,8 +37,10 @@
 //                                itself more often.
 //
 // The code is in these files, which share what pe/state.hpp declares:
-//   build_mode.cpp  run-time values, statements, cells, output, the rebound
-//                   primitives and BuildSession (this file)
+//   specialized.cpp the one table of the primitives a build rebinds, with
+//                   the function each means (defined in the files below)
+//   build_mode.cpp  run-time values, statements, cells, output, tests of
+//                   run-time values and BuildSession (this file)
 //   numerics.cpp    tracing procedures into functions; the numerical
 //                   primitives (integrals, minimizers, roots, state
 //                   advancers, evolve)
@@ -68,6 +70,7 @@
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
 #include "eval/procedure.hpp"
+#include "pe/specialized.hpp"
 #include "pe/state.hpp"
 #include "print/printer.hpp"
 
@@ -655,6 +658,34 @@ Value prepare_toplevel(Value v) {
 
 } // namespace
 
+// What this file specializes (the table is pe/specialized.cpp).
+const PrimFn p_display = P_print<kDisplay>, p_write = P_print<kWrite>,
+             p_write_line = P_print<kWriteLine>, p_pp = P_print<kPp>,
+             p_print_expression = P_print<kPrintExpression>, p_pe = P_print<kPe>;
+const PrimFn p_less = P_compare<kLess, RCompute::Less, false>,
+             p_greater = P_compare<kGreater, RCompute::Less, true>,
+             p_less_eq = P_compare<kLessEq, RCompute::LessEq, false>,
+             p_greater_eq = P_compare<kGreaterEq, RCompute::LessEq, true>,
+             p_num_equal = P_compare<kEqual, RCompute::Equal, false>;
+const PrimFn p_zero_p = P_sign_test<kZero, RCompute::Equal, false>,
+             p_positive_p = P_sign_test<kPositive, RCompute::Less, true>,
+             p_negative_p = P_sign_test<kNegative, RCompute::Less, false>;
+const PrimFn p_floor = P_unary<kFloor, RCompute::Floor>, p_round = P_unary<kRound, RCompute::Round>,
+             p_truncate = P_unary<kTruncate, RCompute::Truncate>,
+             p_max = P_fold<kMax, RCompute::Max>, p_min = P_fold<kMin, RCompute::Min>,
+             p_not = P_not;
+const PrimFn p_eq_p = P_same<kEqP, false>, p_eqv_p = P_same<kEqvP, false>,
+             p_equal_p = P_same<kEqualP, true>;
+const PrimFn p_real_time = P_real_time, p_parameter = P_parameter, p_runtime = P_runtime;
+const PrimFn p_number_p = P_number_test<kNumberP>, p_real_p = P_number_test<kRealP>,
+             p_inexact_p = P_number_test<kInexactP>, p_exact_p = P_number_test<kExactP>,
+             p_integer_p = P_number_test<kIntegerP>,
+             p_exact_integer_p = P_number_test<kExactIntegerP>,
+             p_exact_nonnegative_integer_p = P_number_test<kExactNonnegP>,
+             p_exact_rational_p = P_number_test<kExactRationalP>;
+const PrimFn p_exact_to_inexact = P_identity_on_dynamic<kExactToInexact>,
+             p_inexact = P_identity_on_dynamic<kInexact>;
+
 Value call_original(const char *name, Value *a, int n) {
   return original(name)(a, n);
 }
@@ -698,49 +729,11 @@ void begin_build_mode(build::BuildState *state) {
   g_build->advancer_lambda.name = intern("state-advancer").symbol();
   g_build->evolver_lambda.name = intern("evolve").symbol();
 
-  rebind("display", 1, 2, P_print<kDisplay>);
-  rebind("write", 1, 2, P_print<kWrite>);
-  rebind("write-line", 1, 2, P_print<kWriteLine>);
-  rebind("pp", 1, 2, P_print<kPp>);
-  rebind("print-expression", 1, 1, P_print<kPrintExpression>);
-  rebind("pe", 1, 1, P_print<kPe>);
-  rebind("<", 1, kVariadic, P_compare<kLess, RCompute::Less, false>);
-  rebind(">", 1, kVariadic, P_compare<kGreater, RCompute::Less, true>);
-  rebind("<=", 1, kVariadic, P_compare<kLessEq, RCompute::LessEq, false>);
-  rebind(">=", 1, kVariadic, P_compare<kGreaterEq, RCompute::LessEq, true>);
-  rebind("=", 1, kVariadic, P_compare<kEqual, RCompute::Equal, false>);
-  rebind("zero?", 1, 1, P_sign_test<kZero, RCompute::Equal, false>);
-  rebind("positive?", 1, 1, P_sign_test<kPositive, RCompute::Less, true>);
-  rebind("negative?", 1, 1, P_sign_test<kNegative, RCompute::Less, false>);
-  rebind("floor", 1, 1, P_unary<kFloor, RCompute::Floor>);
-  rebind("round", 1, 1, P_unary<kRound, RCompute::Round>);
-  rebind("truncate", 1, 1, P_unary<kTruncate, RCompute::Truncate>);
-  rebind("max", 1, kVariadic, P_fold<kMax, RCompute::Max>);
-  rebind("min", 1, kVariadic, P_fold<kMin, RCompute::Min>);
-  rebind("not", 1, 1, P_not);
-  rebind("eq?", 2, 2, P_same<kEqP, false>);
-  rebind("eqv?", 2, 2, P_same<kEqvP, false>);
-  rebind("equal?", 2, 2, P_same<kEqualP, true>);
-  rebind("real-time", 0, 0, P_real_time);
-  rebind("parameter", 2, 2, P_parameter);
-  rebind("runtime", 0, 0, P_runtime);
-  rebind("number?", 1, 1, P_number_test<kNumberP>);
-  rebind("real?", 1, 1, P_number_test<kRealP>);
-  rebind("inexact?", 1, 1, P_number_test<kInexactP>);
-  rebind("exact?", 1, 1, P_number_test<kExactP>);
-  rebind("integer?", 1, 1, P_number_test<kIntegerP>);
-  rebind("exact-integer?", 1, 1, P_number_test<kExactIntegerP>);
-  rebind("exact-nonnegative-integer?", 1, 1, P_number_test<kExactNonnegP>);
-  rebind("exact-rational?", 1, 1, P_number_test<kExactRationalP>);
-  rebind("exact->inexact", 1, 1, P_identity_on_dynamic<kExactToInexact>);
-  rebind("inexact", 1, 1, P_identity_on_dynamic<kInexact>);
-
-  rebind_numerical_primitives();
-  rebind_plot_primitives();
-
-  rebind_list_primitives();
-  rebind_parallel_primitives();
-  rebind_mutators();
+  for (const Specialization &p : specializations()) {
+    Symbol *s = intern(p.name).symbol();
+    if (p.only_over_a_primitive && !(s->bound && s->global.is(Tag::Primitive))) continue;
+    rebind(p.name, p.min_args, p.max_args, p.fn);
+  }
 
   set_output_hook(residual_output);
   set_capture_hook(hook_capture);

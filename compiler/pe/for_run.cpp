@@ -36,6 +36,7 @@
 #include "eval/core.hpp"
 #include "eval/procedure.hpp"
 #include "pe/build.hpp"
+#include "pe/specialized.hpp"
 #include "pe/state.hpp"
 
 namespace sicm {
@@ -67,16 +68,6 @@ Value P_effect(Value *, int) {
   refuse(here(), "an effect (a mutation, output, random numbers or the clock)");
 }
 
-// The primitives whose effect would happen once, at compile time, instead
-// of at each call. (Mutations of what the procedure did not make, and
-// forcing promises it did not make, sicm build refuses too: pe/branches.cpp.)
-const char *const kEffects[] = {
-    "random",       "runtime",          "real-time",  "exit",
-    "%exit",        "newline",          "fresh-line", "write-char",
-    "write-string", "display",          "write",      "write-line",
-    "pp",           "print-expression", "pe",         "with-output-to-string",
-};
-
 const DynamicBranchHooks kForRunHooks = {hook_dynamic_test,   hook_branch,       hook_logic,
                                          for_run_set_global,  for_run_set_local, hook_call_closure,
                                          hook_apply_to_other, hook_forcing};
@@ -86,7 +77,7 @@ const DynamicBranchHooks kForRunHooks = {hook_dynamic_test,   hook_branch,      
 class TraceForRun {
 public:
   TraceForRun() {
-    for (const char *name : kEffects)
+    for (const char *name : effects_refused_for_run())
       rebind(name, 0, kVariadic, P_effect);
     g_dynamic_branch_hooks = &kForRunHooks;
     set_output_hook(for_run_output);

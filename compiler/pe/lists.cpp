@@ -10,6 +10,7 @@
 #include "base/primitive.hpp"
 #include "codegen/state_shape.hpp"
 #include "eval/procedure.hpp"
+#include "pe/specialized.hpp"
 #include "pe/state.hpp"
 
 namespace sicm::build {
@@ -438,56 +439,15 @@ template <const char *Name> Value P_list_refused(Value *a, int n) {
   return call_original(Name, a, n);
 }
 
-template <const char *Name> void rebind_cxr() {
-  rebind(Name, 1, 1, P_list_cxr<Name>);
-}
 constexpr char kCaar[] = "caar", kCadr[] = "cadr", kCdar[] = "cdar", kCddr[] = "cddr",
                kCaddr[] = "caddr", kCdddr[] = "cdddr", kCadddr[] = "cadddr", kFirst[] = "first",
                kSecond[] = "second", kThird[] = "third", kFourth[] = "fourth", kFifth[] = "fifth";
 
-void rebind_cxrs() {
-  rebind_cxr<kCaar>();
-  rebind_cxr<kCadr>();
-  rebind_cxr<kCdar>();
-  rebind_cxr<kCddr>();
-  rebind_cxr<kCaddr>();
-  rebind_cxr<kCdddr>();
-  rebind_cxr<kCadddr>();
-  rebind_cxr<kFirst>();
-  rebind_cxr<kSecond>();
-  rebind_cxr<kThird>();
-  rebind_cxr<kFourth>();
-  rebind_cxr<kFifth>();
-}
-
-// The list primitives that refuse run-time lists, with their arities.
-template <const char *Name> void refuse(int min, int max) {
-  Symbol *s = intern(Name).symbol();
-  if (s->bound && s->global.is(Tag::Primitive)) rebind(Name, min, max, P_list_refused<Name>);
-}
 constexpr char kAppend[] = "append", kListCopy[] = "list-copy", kListToVector[] = "list->vector",
                kSort[] = "sort", kFilter[] = "filter", kReduce[] = "reduce",
                kFoldLeft[] = "fold-left", kFoldRight[] = "fold-right", kListHead[] = "list-head",
                kSublist[] = "sublist", kLastPair[] = "last-pair", kMember[] = "member",
                kMemv[] = "memv", kAssoc[] = "assoc", kAppendMap[] = "append-map";
-
-void rebind_refused() {
-  refuse<kAppend>(0, kVariadic);
-  refuse<kListCopy>(1, 1);
-  refuse<kListToVector>(1, 1);
-  refuse<kSort>(2, 2);
-  refuse<kFilter>(2, 2);
-  refuse<kReduce>(3, 3);
-  refuse<kFoldLeft>(3, kVariadic);
-  refuse<kFoldRight>(3, kVariadic);
-  refuse<kListHead>(2, 2);
-  refuse<kSublist>(3, 3);
-  refuse<kLastPair>(1, 1);
-  refuse<kMember>(2, 3);
-  refuse<kMemv>(2, 2);
-  refuse<kAssoc>(2, 3);
-  refuse<kAppendMap>(2, kVariadic); // equal?: see P_same in pe/build_mode.cpp
-}
 
 } // namespace
 
@@ -567,21 +527,23 @@ bool hook_apply_to_other(Value f, Value *args, long nargs, Value *out) {
   return true;
 }
 
-void rebind_list_primitives() {
-  rebind("car", 1, 1, P_list_car);
-  rebind("cdr", 1, 1, P_list_cdr);
-  rebind("null?", 1, 1, P_list_null);
-  rebind("pair?", 1, 1, P_list_pair);
-  rebind("list?", 1, 1, P_list_list_p);
-  rebind("length", 1, 1, P_list_length);
-  rebind("reverse", 1, 1, P_list_reverse);
-  rebind("list-ref", 2, 2, P_list_ref);
-  rebind("list-tail", 2, 2, P_list_tail);
-  rebind("last", 1, 1, P_list_last);
-  rebind("map", 2, kVariadic, P_list_map<kMap, true>);
-  rebind("for-each", 2, kVariadic, P_list_map<kForEach, false>);
-  rebind_cxrs();
-  rebind_refused();
-}
+// What this file specializes (the table is pe/specialized.cpp).
+const PrimFn p_car = P_list_car, p_cdr = P_list_cdr, p_null_p = P_list_null, p_pair_p = P_list_pair,
+             p_list_p = P_list_list_p, p_length = P_list_length, p_reverse = P_list_reverse,
+             p_list_ref = P_list_ref, p_list_tail = P_list_tail, p_last = P_list_last,
+             p_map = P_list_map<kMap, true>, p_for_each = P_list_map<kForEach, false>;
+const PrimFn p_caar = P_list_cxr<kCaar>, p_cadr = P_list_cxr<kCadr>, p_cdar = P_list_cxr<kCdar>,
+             p_cddr = P_list_cxr<kCddr>, p_caddr = P_list_cxr<kCaddr>, p_cdddr = P_list_cxr<kCdddr>,
+             p_cadddr = P_list_cxr<kCadddr>, p_first = P_list_cxr<kFirst>,
+             p_second = P_list_cxr<kSecond>, p_third = P_list_cxr<kThird>,
+             p_fourth = P_list_cxr<kFourth>, p_fifth = P_list_cxr<kFifth>;
+const PrimFn p_append = P_list_refused<kAppend>, p_list_copy = P_list_refused<kListCopy>,
+             p_list_to_vector = P_list_refused<kListToVector>, p_sort = P_list_refused<kSort>,
+             p_filter = P_list_refused<kFilter>, p_reduce = P_list_refused<kReduce>,
+             p_fold_left = P_list_refused<kFoldLeft>, p_fold_right = P_list_refused<kFoldRight>,
+             p_list_head = P_list_refused<kListHead>, p_sublist = P_list_refused<kSublist>,
+             p_last_pair = P_list_refused<kLastPair>, p_member = P_list_refused<kMember>,
+             p_memv = P_list_refused<kMemv>, p_assoc = P_list_refused<kAssoc>,
+             p_append_map = P_list_refused<kAppendMap>;
 
 } // namespace sicm::build

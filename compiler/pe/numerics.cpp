@@ -21,6 +21,7 @@
 #include "codegen/state_shape.hpp"
 #include "codegen/trace.hpp"
 #include "eval/procedure.hpp"
+#include "pe/specialized.hpp"
 #include "pe/state.hpp"
 #include "print/printer.hpp"
 
@@ -556,16 +557,13 @@ Value P_evolve(Value *a, int n) {
 
 } // namespace
 
-void rebind_numerical_primitives() {
-  rebind("definite-integral", 3, 5, retrying<P_definite_integral>);
-  rebind("minimize", 3, 4, retrying<P_minimize<kMinimize>>);
-  rebind("brent-min", 3, 4, retrying<P_minimize<kBrentMin>>);
-  rebind("multidimensional-minimize", 2, 3, retrying<P_multidimensional_minimize>);
-  rebind("find-root", 3, 4, retrying<P_find_root>);
-  rebind("nelder-mead", 2, 5, P_nelder_mead);
-  rebind("bisect", 4, 5, retrying<P_bisect>);
-  rebind("state-advancer", 1, kVariadic, P_state_advancer);
-  rebind("evolve", 1, kVariadic, P_evolve);
-}
+// What this file specializes (the table is pe/specialized.cpp).
+const PrimFn p_definite_integral = retrying<P_definite_integral>,
+             p_minimize = retrying<P_minimize<kMinimize>>,
+             p_brent_min = retrying<P_minimize<kBrentMin>>,
+             p_multidimensional_minimize = retrying<P_multidimensional_minimize>,
+             p_find_root = retrying<P_find_root>, p_nelder_mead = P_nelder_mead,
+             p_bisect = retrying<P_bisect>, p_state_advancer = P_state_advancer,
+             p_evolve = P_evolve;
 
 } // namespace sicm::build

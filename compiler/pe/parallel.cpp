@@ -24,6 +24,7 @@
 #include "base/number.hpp"
 #include "codegen/state_shape.hpp"
 #include "eval/captured_assignment.hpp"
+#include "pe/specialized.hpp"
 #include "pe/state.hpp"
 
 namespace sicm::build {
@@ -157,9 +158,7 @@ template <bool Collect> Value P_parallel_map(Value *a, int n) {
 
 } // namespace
 
-void rebind_parallel_primitives() {
-  rebind("parallel-map", 2, kVariadic, P_parallel_map<true>);
-  rebind("parallel-for-each", 2, kVariadic, P_parallel_map<false>);
-}
+// What this file specializes (the table is pe/specialized.cpp).
+const PrimFn p_parallel_map = P_parallel_map<true>, p_parallel_for_each = P_parallel_map<false>;
 
 } // namespace sicm::build

@@ -8,6 +8,7 @@
 #include "base/number.hpp"
 #include "base/primitive.hpp"
 #include "builtins/plot.hpp"
+#include "pe/specialized.hpp"
 #include "pe/state.hpp"
 
 namespace sicm::build {
@@ -88,12 +89,8 @@ Value P_graphics_clear(Value *a, int) {
 
 } // namespace
 
-void rebind_plot_primitives() {
-  rebind("frame", 4, 7, P_frame);
-  rebind("plot-point", 3, 3, P_plot_point);
-  rebind("plot-line", 5, 5, P_plot_line);
-  rebind("graphics-close", 1, 1, P_graphics_close);
-  rebind("graphics-clear", 1, 1, P_graphics_clear);
-}
+// What this file specializes (the table is pe/specialized.cpp).
+const PrimFn p_frame = P_frame, p_plot_point = P_plot_point, p_plot_line = P_plot_line,
+             p_graphics_close = P_graphics_close, p_graphics_clear = P_graphics_clear;
 
 } // namespace sicm::build

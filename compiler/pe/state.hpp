@@ -191,10 +191,6 @@ Value let(RCompute c, std::vector<ExprId> args, RType type);
 Value call_original(const char *name, Value *a, int n);
 // Define the primitive `name` as fn, keeping the one it replaces for call_original.
 void rebind(const char *name, int min, int max, PrimFn fn);
-void rebind_numerical_primitives(); // pe/numerics.cpp
-void rebind_plot_primitives();      // pe/plots.cpp
-void rebind_list_primitives();      // pe/lists.cpp
-void rebind_parallel_primitives();  // pe/parallel.cpp
 
 // ---- branches on run-time values (pe/branches.cpp) -------------------------------------
 
@@ -212,8 +208,6 @@ Value hook_set_global(Symbol *s, Value v, SrcLoc loc);
 Value hook_set_local(Frame *f, uint32_t index, Value v, SrcLoc loc);
 void hook_forcing(Value promise);
 void hook_capture();
-// set-car!, vector-set!, ... refuse objects made outside the traced procedure.
-void rebind_mutators();
 
 // ---- procedures traced into functions (pe/numerics.cpp) ----------------------------
 
