@@ -8,6 +8,7 @@
 #include "base/number.hpp"
 #include "base/primitive.hpp"
 #include "builtins/builtins.hpp"
+#include "codegen/trace.hpp"
 #include "eval/analyze.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
@@ -295,10 +296,12 @@ Value P_exit(Value *a, int n) {
 
 // MIT's runtime: the processor time used so far, in seconds.
 Value P_runtime(Value *, int) {
+  refuse_in_kernel_trace("runtime");
   return Value::flonum(static_cast<double>(std::clock()) / CLOCKS_PER_SEC);
 }
 
 Value P_real_time(Value *, int) {
+  refuse_in_kernel_trace("real-time");
   using namespace std::chrono;
   double ms = duration<double, std::milli>(system_clock::now().time_since_epoch()).count();
   return Value::flonum(ms);

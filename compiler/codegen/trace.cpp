@@ -135,9 +135,24 @@ bool is_numeric_shape(Value v) {
   return true;
 }
 
+namespace {
+thread_local int g_kernel_traces = 0; // apply_traced calls running on this thread
+} // namespace
+
+void refuse_in_kernel_trace(const char *who) {
+  if (g_kernel_traces > 0)
+    runtime_error(current_call_loc(),
+                  std::string(who) + " is not a function of its arguments: a kernel would hold "
+                                     "the one value it gives while the procedure is traced");
+}
+
 Value apply_traced(Value proc, gcvec<Value> args) {
   DecimalConstants decimal; // 9.8 means 49/5 in the kernel's algebra
   KernelTracing tracing;    // a matrix of run-time values is solved, not inverted
+  struct Counted {
+    Counted() { ++g_kernel_traces; }
+    ~Counted() { --g_kernel_traces; }
+  } counted;
   return apply_procedure(proc, args.data(), static_cast<int>(args.size()));
 }
 

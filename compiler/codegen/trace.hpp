@@ -40,6 +40,13 @@ struct Trace {
 // kernel_outputs (codegen/kernel_form.hpp). Errors propagate.
 Value apply_traced(Value proc, gcvec<Value> args);
 
+// Primitives whose value is not a function of their arguments (random, the
+// clocks) call this first: while apply_traced runs it raises, so that the
+// procedure stays interpreted, where a kernel would hold the one number drawn
+// or read while tracing. (sicm build gives them their own meaning: see
+// pe/specialized.cpp.) who: the primitive, for the message.
+void refuse_in_kernel_trace(const char *who);
+
 // Trace `proc` on arguments shaped like the elements of the list sample_args
 // (each a number or a nested up/down structure of numbers). Returns false and
 // a one-line reason in *why_not when the procedure cannot be traced. Errors

@@ -616,6 +616,22 @@ Value P_parameter(Value *a, int) {
   return v;
 }
 
+// A number drawn while compiling is the one sicm run draws only where the
+// program runs once and in order: not in a procedure traced for run time
+// (which runs at each call), under a test on a run-time value (both
+// alternatives are evaluated, so every later draw would differ) or in a
+// loop left for run time (its body is evaluated once).
+Value P_random(Value *a, int n) {
+  const char *where = g_build->open.size() > 1    ? "in a procedure traced for run time"
+                      : g_build->branch_depth > 0 ? "under a test on a value known only at run time"
+                      : !g_build->loops.empty()   ? "in a loop left for run time"
+                                                  : nullptr;
+  if (where)
+    cannot_compile(here(), std::string("random numbers drawn ") + where +
+                               " (they would be drawn once, while compiling)");
+  return call_original("random", a, n);
+}
+
 Value P_not(Value *a, int n) {
   if (is_dynamic_boolean(a[0])) return let(RCompute::Not, {expr_of(a[0], "not")}, RType::Boolean);
   return call_original("not", a, n);
@@ -676,7 +692,8 @@ const PrimFn p_floor = P_unary<kFloor, RCompute::Floor>, p_round = P_unary<kRoun
              p_not = P_not;
 const PrimFn p_eq_p = P_same<kEqP, false>, p_eqv_p = P_same<kEqvP, false>,
              p_equal_p = P_same<kEqualP, true>;
-const PrimFn p_real_time = P_real_time, p_parameter = P_parameter, p_runtime = P_runtime;
+const PrimFn p_random = P_random, p_real_time = P_real_time, p_parameter = P_parameter,
+             p_runtime = P_runtime;
 const PrimFn p_number_p = P_number_test<kNumberP>, p_real_p = P_number_test<kRealP>,
              p_inexact_p = P_number_test<kInexactP>, p_exact_p = P_number_test<kExactP>,
              p_integer_p = P_number_test<kIntegerP>,

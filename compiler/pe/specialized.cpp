@@ -37,7 +37,9 @@ const std::vector<Specialization> &specializations() {
       {"eq?", 2, 2, p_eq_p},
       {"eqv?", 2, 2, p_eqv_p},
       {"equal?", 2, 2, p_equal_p},
-      // The clocks and parameters are read at run time.
+      // Random numbers are drawn while compiling, where that draws what
+      // sicm run draws; the clocks and parameters are read at run time.
+      {"random", 1, 2, p_random},
       {"real-time", 0, 0, p_real_time},
       {"parameter", 2, 2, p_parameter},
       {"runtime", 0, 0, p_runtime},
