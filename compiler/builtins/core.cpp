@@ -8,9 +8,9 @@
 #include "base/number.hpp"
 #include "base/primitive.hpp"
 #include "builtins/builtins.hpp"
-#include "codegen/trace.hpp"
 #include "eval/analyze.hpp"
 #include "eval/core.hpp"
+#include "eval/effect_guard.hpp"
 #include "eval/interp.hpp"
 #include "eval/procedure.hpp"
 #include "print/pretty.hpp"
@@ -102,6 +102,7 @@ void set_capture_hook(CaptureHook hook) {
 
 void output(std::string_view s) {
   if (s.empty()) return;
+  refuse_effect("output");
   if (g_capture) {
     if (g_capture_hook) g_capture_hook();
     g_capture->append(s);
@@ -296,12 +297,12 @@ Value P_exit(Value *a, int n) {
 
 // MIT's runtime: the processor time used so far, in seconds.
 Value P_runtime(Value *, int) {
-  refuse_in_kernel_trace("runtime");
+  refuse_effect("runtime");
   return Value::flonum(static_cast<double>(std::clock()) / CLOCKS_PER_SEC);
 }
 
 Value P_real_time(Value *, int) {
-  refuse_in_kernel_trace("real-time");
+  refuse_effect("real-time");
   using namespace std::chrono;
   double ms = duration<double, std::milli>(system_clock::now().time_since_epoch()).count();
   return Value::flonum(ms);

@@ -8,6 +8,7 @@
 #include "builtins/builtins.hpp"
 #include "eval/captured_assignment.hpp"
 #include "eval/core.hpp"
+#include "eval/effect_guard.hpp"
 #include "eval/procedure.hpp"
 
 namespace sicm {
@@ -35,11 +36,13 @@ Value P_cdr(Value *a, int) {
   return cdr(require_pair(a, 0, "cdr"));
 }
 Value P_set_car(Value *a, int) {
-  require_pair(a, 0, "set-car!").pair()->car = a[1];
+  refuse_change_of(require_pair(a, 0, "set-car!"), "set-car!");
+  a[0].pair()->car = a[1];
   return Value::unspecified();
 }
 Value P_set_cdr(Value *a, int) {
-  require_pair(a, 0, "set-cdr!").pair()->cdr = a[1];
+  refuse_change_of(require_pair(a, 0, "set-cdr!"), "set-cdr!");
+  a[0].pair()->cdr = a[1];
   return Value::unspecified();
 }
 
@@ -108,6 +111,7 @@ Value P_append_bang(Value *a, int n) {
       Value p = last;
       while (is_pair(cdr(p)))
         p = cdr(p);
+      refuse_change_of(p, "append!");
       p.pair()->cdr = a[i];
     }
     last = a[i];

@@ -11,7 +11,7 @@
 #include "base/number_internal.hpp"
 #include "base/primitive.hpp"
 #include "builtins/builtins.hpp"
-#include "codegen/trace.hpp"
+#include "eval/effect_guard.hpp"
 
 namespace sicm {
 
@@ -290,7 +290,7 @@ double random_flonum(double limit) {
 }
 
 Value prim_random(Value *a, int) {
-  refuse_in_kernel_trace("random");
+  refuse_draw("random");
   Value n = a[0];
   if (is_flonum(n)) {
     if (!(n.d > 0) || !std::isfinite(n.d)) bad_range(n, 1, "random");

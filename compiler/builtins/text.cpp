@@ -13,6 +13,7 @@
 #include "base/primitive.hpp"
 #include "base/utf8.hpp"
 #include "builtins/builtins.hpp"
+#include "eval/effect_guard.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 
@@ -315,6 +316,7 @@ void install_strings() {
   });
   define_primitive("string-set!", 3, 3, [](Value *a, int) {
     String *s = arg_str(a, 0, "string-set!");
+    refuse_change_of(a[0], "string-set!");
     if (!a[1].is(Tag::Fixnum)) wrong_type(a[1], 2, "string-set!");
     if (a[1].i < 0 || static_cast<size_t>(a[1].i) >= s->len) bad_range(a[1], 2, "string-set!");
     uint32_t c = arg_char(a, 2, "string-set!");

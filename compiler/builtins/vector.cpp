@@ -6,6 +6,7 @@
 #include "base/number.hpp"
 #include "base/primitive.hpp"
 #include "builtins/builtins.hpp"
+#include "eval/effect_guard.hpp"
 #include "eval/procedure.hpp"
 
 namespace sicm {
@@ -100,6 +101,7 @@ void install_basics() {
   });
   define_primitive("vector-set!", 3, 3, [](Value *a, int) {
     Vector *v = arg_vector(a, 0, "vector-set!");
+    refuse_change_of(a[0], "vector-set!");
     v->items[arg_element(a, 1, v, "vector-set!")] = a[2];
     return Value::unspecified();
   });
@@ -159,6 +161,7 @@ void install_slices() {
   // (vector-copy! to at from [start end]), R7RS; overlapping ranges are safe.
   define_primitive("vector-copy!", 3, 5, [](Value *a, int n) {
     Vector *to = arg_vector(a, 0, "vector-copy!");
+    refuse_change_of(a[0], "vector-copy!");
     size_t at = arg_bounded(a, 1, 0, to->len, "vector-copy!");
     Vector *from = arg_vector(a, 2, "vector-copy!");
     auto [start, end] = arg_span(a, n, 3, from->len, "vector-copy!");
@@ -195,6 +198,7 @@ void install_slices() {
   });
   define_primitive("vector-fill!", 2, 4, [](Value *a, int n) {
     Vector *v = arg_vector(a, 0, "vector-fill!");
+    refuse_change_of(a[0], "vector-fill!");
     auto [start, end] = arg_span(a, n, 2, v->len, "vector-fill!");
     for (size_t i = start; i < end; ++i)
       v->items[i] = a[1];

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -27,6 +28,7 @@
 #include "codegen/kernel_form.hpp"
 #include "codegen/singular_factors.hpp"
 #include "codegen/state_shape.hpp"
+#include "eval/effect_guard.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 
@@ -70,8 +72,13 @@ bool check_expression(ExprId root, const std::unordered_set<Symbol *> &inputs,
     case ExprKind::Flonum: break;
     case ExprKind::Symbol:
       if (!inputs.count(n.sym)) {
-        *why_not = "the result depends on the symbol " + n.sym->name +
-                   ", which is not an argument (give it a numeric value)";
+        RunTimeValueTest run_time = run_time_value_test(); // sicm build's values
+        if (run_time && run_time(Value::object(Tag::Symbol, n.sym)))
+          *why_not = "the result depends on a value known only when the built program runs "
+                     "(a numerical result, a parameter, a clock)";
+        else
+          *why_not = "the result depends on the symbol " + n.sym->name +
+                     ", which is not an argument (give it a numeric value)";
         return false;
       }
       break;
@@ -135,24 +142,12 @@ bool is_numeric_shape(Value v) {
   return true;
 }
 
-namespace {
-thread_local int g_kernel_traces = 0; // apply_traced calls running on this thread
-} // namespace
-
-void refuse_in_kernel_trace(const char *who) {
-  if (g_kernel_traces > 0)
-    runtime_error(current_call_loc(),
-                  std::string(who) + " is not a function of its arguments: a kernel would hold "
-                                     "the one value it gives while the procedure is traced");
-}
-
 Value apply_traced(Value proc, gcvec<Value> args) {
   DecimalConstants decimal; // 9.8 means 49/5 in the kernel's algebra
   KernelTracing tracing;    // a matrix of run-time values is solved, not inverted
-  struct Counted {
-    Counted() { ++g_kernel_traces; }
-    ~Counted() { --g_kernel_traces; }
-  } counted;
+  // In sicm build the partial evaluator's rules for effects apply, but for
+  // random numbers, which it would draw while compiling.
+  EffectGuard effects(g_dynamic_branch_hooks ? Refused::Draws : Refused::All);
   return apply_procedure(proc, args.data(), static_cast<int>(args.size()));
 }
 
@@ -184,6 +179,9 @@ bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_n
     args.push_back(state_from_leaves(samples[i], leaves));
   }
   try {
+    // A kernel runs without the partial evaluator even in sicm build
+    // (compile-procedure), so no effect may happen only while tracing.
+    EffectGuard effects(Refused::All);
     return collect_outputs(apply_traced(proc, args), t, why_not);
   } catch (const Error &e) {
     *why_not = std::string("applying it to symbolic arguments failed: ") + e.what();

@@ -35,17 +35,12 @@ struct Trace {
 // derivatives): proc applied to args whose scalar leaves are the symbols
 // that stand for the kernel's inputs, with flonums entering the algebra as
 // the decimals they were written as (DecimalConstants) and divisions by
-// matrices of run-time values as solve nodes (KernelTracing). The caller
-// takes the result's leaves (codegen/state_shape.hpp) and gives them to
-// kernel_outputs (codegen/kernel_form.hpp). Errors propagate.
+// matrices of run-time values as solve nodes (KernelTracing), and, in
+// sicm run, effects that would happen once instead of at each call refused
+// (EffectGuard, eval/effect_guard.hpp). The caller takes the result's
+// leaves (codegen/state_shape.hpp) and gives them to kernel_outputs
+// (codegen/kernel_form.hpp). Errors propagate.
 Value apply_traced(Value proc, gcvec<Value> args);
-
-// Primitives whose value is not a function of their arguments (random, the
-// clocks) call this first: while apply_traced runs it raises, so that the
-// procedure stays interpreted, where a kernel would hold the one number drawn
-// or read while tracing. (sicm build gives them their own meaning: see
-// pe/specialized.cpp.) who: the primitive, for the message.
-void refuse_in_kernel_trace(const char *who);
 
 // Trace `proc` on arguments shaped like the elements of the list sample_args
 // (each a number or a nested up/down structure of numbers). Returns false and

@@ -15,6 +15,7 @@
 #include "base/limits.hpp"
 #include "base/primitive.hpp"
 #include "eval/core.hpp"
+#include "eval/effect_guard.hpp"
 #include "eval/procedure.hpp"
 
 namespace sicm {
@@ -312,6 +313,7 @@ Value eval(Node *n, Frame *env) {
       Frame *f = env;
       for (uint16_t d = n->depth; d > 0; --d)
         f = f->parent;
+      refuse_set_local(f->serial, n->loc);
       if (g_dynamic_branch_hooks) v = g_dynamic_branch_hooks->set_local(f, n->index, v, n->loc);
       f->slots[n->index] = v;
       return Value::unspecified();
@@ -320,6 +322,7 @@ Value eval(Node *n, Frame *env) {
       Value v = eval(n->kids[0], env);
       Symbol *s = n->value.symbol();
       if (!s->bound) runtime_error(n->loc, "Unbound variable: " + s->name);
+      refuse_set_global(s, n->loc);
       if (g_dynamic_branch_hooks) v = g_dynamic_branch_hooks->set_global(s, v, n->loc);
       s->global = v;
       return Value::unspecified();
