@@ -2,10 +2,11 @@
 // residual program (see codegen/residual.hpp for the idea).
 //
 // A BuildSession (begin_build_mode, below) rebinds the primitives whose
-// meaning changes, until it ends (end_build_mode puts them back): the
-// numerical primitives record a statement and return fresh run-time values;
-// plots record their statements; comparisons, floor, max and min of run-time
-// values become statements; printing names the run-time values it prints.
+// meaning changes (all listed in pe/specialized.cpp's table), until it ends
+// (end_build_mode puts them back): the numerical primitives record a
+// statement and return fresh run-time values; plots record their
+// statements; comparisons, floor, max and min of run-time values become
+// statements; printing names the run-time values it prints.
 // The evaluator's branch hooks make `if`, `and` and `or` on a run-time truth
 // value evaluate both alternatives and select between their values at run
 // time. Everything else runs as it always does, at compile time.
