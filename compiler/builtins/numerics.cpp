@@ -11,10 +11,11 @@
 // (ScalarCallback, VectorCallback, OdeCallback below). When the procedure is
 // a native kernel (compile-procedure, codegen/kernel.hpp) of the right
 // shape, the same callbacks run the kernel on the doubles directly, without
-// making Scheme values; a pass that compiles system derivatives and
-// integrands automatically only has to hand a kernel in. bisect's function,
-// when one interpreted call proves expensive, is compiled by sicm build's
-// partial evaluator (pe/for_run.cpp), loops and tests included.
+// making Scheme values. Which procedures run compiled, and how they are
+// compiled, builtins/compiled_procedures.hpp decides: system derivatives as
+// kernels, or by sicm build's partial evaluator when they test the state
+// (pe/for_run.cpp), and bisect's function, when one interpreted call proves
+// expensive, by the partial evaluator too, loops and tests included.
 //
 // Errors. A Scheme error (or a continuation escape) inside a callback must
 // not unwind through the runtime's C frames: the callback catches it, tells
@@ -48,6 +49,7 @@
 #include "base/limits.hpp"
 #include "base/number.hpp"
 #include "base/primitive.hpp"
+#include "builtins/compiled_procedures.hpp"
 #include "builtins/integration_sites.hpp"
 #include "builtins/numerics_defaults.hpp"
 #include "codegen/kernel.hpp"
@@ -169,7 +171,7 @@ struct ScalarCallback : Callback {
   // compile_expensive: f compiled by the partial evaluator once one
   // interpreted call has taken kCompileAfterSteps steps (compiled: the result).
   bool compile_expensive = false, compile_tried = false;
-  CompiledScalarFn compiled = nullptr;
+  CompiledFn compiled = nullptr;
   bool nonfinite = false; // f returned a NaN or an infinity, first at bad_x
   double bad_x = 0, bad_value = 0;
   ScalarCallback(SrcLoc l, const char *w, Value fn)
@@ -204,7 +206,11 @@ double real_result(const Callback &cb, Value r, const std::string &at) {
 constexpr uint64_t kCompileAfterSteps = 50000;
 
 // Compile cb's procedure by the partial evaluator (compile_for_run), once.
-void compile_expensive(ScalarCallback &cb);
+// Compile cb's procedure by the partial evaluator, once.
+void compile_expensive(ScalarCallback &cb) {
+  cb.compile_tried = true;
+  cb.compiled = compile_expensive_function(cb.f, cb.who);
+}
 
 double call_scalar(double x, void *data) {
   auto *cb = static_cast<ScalarCallback *>(data);
@@ -402,6 +408,7 @@ struct OdeCallback : Callback {
   Value sysder;
   const StateShape *shape;
   const Kernel *kernel = nullptr;   // sysder itself when it is a kernel on the state's shape
+  CompiledFn compiled = nullptr;    // else sysder compiled by the partial evaluator, if it was
   const Kernel *jacobian = nullptr; // (D sysder) on the state's shape, for implicit methods
   std::vector<double> jacobian_out;
   // Every derivative computed so far had exactly 1 as its time component:
@@ -417,6 +424,12 @@ int call_sysder(double, const double *y, double *dydt, void *data) {
   if (cb->error) return 1;
   if (cb->kernel) {
     kernel_call(cb->kernel, y, dydt);
+    if (cb->shape->time_first() && dydt[0] != 1.0) cb->time_rate_one = false;
+    return 0;
+  }
+  // A compiled derivative gives up (1) where the interpreter must compute:
+  // then it does, for this state.
+  if (cb->compiled && cb->compiled(y, dydt, interrupt_flag()) == 0) {
     if (cb->shape->time_first() && dydt[0] != 1.0) cb->time_rate_one = false;
     return 0;
   }
@@ -562,82 +575,6 @@ const sicm_ode_step_type *arg_integrator(Value *a, int n, int i, const char *who
   return T;
 }
 
-// ---- native system derivatives ----------------------------------------------------
-
-// System derivatives are compiled to native kernels automatically: traced,
-// emitted as C, compiled once and cached (codegen/). A procedure that cannot
-// be traced (it branches on the state, calls an unknown function) keeps
-// running interpreted. SICM_INTERPRET=1 in the environment turns this off.
-// Recent (procedure, shape) -> kernel pairs are remembered, because a
-// state advancer inside a map is called over and over with the same
-// procedure.
-struct CompiledSysder {
-  Value sysder;
-  Value state_shape;    // a sample state
-  const Kernel *kernel; // null: not traceable
-  bool taylor;          // compiled with its Taylor coefficients (if it has them)
-};
-gcvec<CompiledSysder> g_compiled; // static, hence a root for the collector
-constexpr size_t kCompiledMemo = 32;
-// Each kernel is a shared object loaded for good (and a root set of the
-// collector); a parameter sweep that makes a new system per point would
-// load thousands. Past this many, derivatives are interpreted.
-constexpr size_t kMaxAutoKernels = 64;
-size_t g_auto_kernels = 0;
-
-bool kernels_enabled() {
-  static const bool enabled = [] {
-    const char *e = std::getenv("SICM_INTERPRET");
-    return !(e && *e && std::strcmp(e, "0") != 0);
-  }();
-  return enabled;
-}
-
-ScalarCompiler g_scalar_compiler = nullptr;
-
-void compile_expensive(ScalarCallback &cb) {
-  cb.compile_tried = true;
-  if (!kernels_enabled() || g_auto_kernels >= kMaxAutoKernels) return;
-  std::string why_not;
-  cb.compiled = g_scalar_compiler ? g_scalar_compiler(cb.f, cb.who, &why_not) : nullptr;
-  if (cb.compiled) ++g_auto_kernels;
-}
-
-// With taylor, the kernel also has the Taylor coefficients of the solution
-// when its operations all have recurrences (the taylor method asks for
-// them; the others do not pay for compiling them).
-const Kernel *auto_kernel(Value sysder, Value state, size_t dim, bool taylor = false) {
-  if (!kernels_enabled() || !is_procedure(sysder)) return nullptr;
-  for (const CompiledSysder &c : g_compiled)
-    if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape) && (c.taylor || !taylor))
-      return c.kernel;
-  if (g_auto_kernels >= kMaxAutoKernels) return nullptr;
-  std::string why;
-  KernelOptions options{.probe_singularities = true, .taylor = taylor};
-  const Kernel *k = compile_kernel(sysder, list({state}), "system_derivative", &why, options);
-  if (k) ++g_auto_kernels;
-  if (k && (k->nin != dim || k->nout != dim)) k = nullptr;
-  if (g_compiled.size() >= kCompiledMemo) g_compiled.erase(g_compiled.begin());
-  g_compiled.push_back(CompiledSysder{sysder, state, k, taylor});
-  return k;
-}
-
-// A kernel of (D sysder) on states shaped like `state`, or null (the
-// derivative cannot be differentiated and traced, or no C compiler).
-const Kernel *jacobian_kernel(Value sysder, Value state, size_t dim) {
-  if (!kernels_enabled()) return nullptr;
-  Symbol *d = intern("D").symbol();
-  if (!d->bound) return nullptr;
-  try {
-    Value dsys = apply_procedure(d->global, &sysder, 1);
-    std::string why;
-    const Kernel *k = compile_kernel(dsys, list({state}), "jacobian", &why);
-    return k && k->nin == dim && k->nout == dim * dim ? k : nullptr;
-  } catch (const Error &) {
-    return nullptr;
-  }
-}
-
 // ---- one integration problem ----------------------------------------------------
 
 // A state, flattened, with its shape and the system derivative's callback.
@@ -662,6 +599,7 @@ struct OdeProblem {
       cb.kernel = k;
     else
       cb.kernel = auto_kernel(sysder, state, shape.dim(), taylor);
+    if (!cb.kernel && !taylor) cb.compiled = auto_residual(sysder, state, who);
     t0 = shape.time_first() && std::isfinite(y[0]) ? y[0] : 0.0;
   }
 
@@ -1177,10 +1115,6 @@ void install_numerics_primitives() {
   define_primitive("evolve", 1, kVariadic, P_evolve);
   define_primitive("eigenvalues", 1, 1, P_eigenvalues);
   define_primitive("matrix->eigenvalues", 1, 1, P_eigenvalues);
-}
-
-void set_scalar_compiler(ScalarCompiler compiler) {
-  g_scalar_compiler = compiler;
 }
 
 } // namespace sicm

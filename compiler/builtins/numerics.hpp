@@ -10,18 +10,27 @@
 
 namespace sicm {
 
-// A procedure of one real compiled for sicm run: writes f(in[0]) to out[0]
+// A procedure compiled for sicm run: writes f(in) to out (f(in[0]) to
+// out[0] for a function of one real; a derivative's leaves for a state's)
 // and returns 0, or returns 1 where the interpreter must compute the value
 // (a checked operation would leave the reals: division by zero, the square
 // root of a negative number; or *interrupt became nonzero in a loop).
-using CompiledScalarFn = int (*)(const double *in, double *out, const volatile int *interrupt);
+using CompiledFn = int (*)(const double *in, double *out, const volatile int *interrupt);
 
 // What compiles bisect's function when one interpreted call proves
 // expensive: f compiled and loaded, or null with the reason in *why_not.
 // sicm build's partial evaluator provides it (pe/for_run.cpp's
 // compile_for_run, given at start-up by driver/init.cpp); without one, the
 // function is interpreted.
-using ScalarCompiler = CompiledScalarFn (*)(Value f, const char *who, std::string *why_not);
+using ScalarCompiler = CompiledFn (*)(Value f, const char *who, std::string *why_not);
 void set_scalar_compiler(ScalarCompiler compiler);
+
+// What compiles a system derivative that the kernel tracer cannot (it tests
+// the state), for states shaped like `state`: compiled and loaded, or null
+// with the reason in *why_not. pe/for_run.cpp's compile_system_for_run,
+// given at start-up; without one, the derivative is interpreted.
+using SystemCompiler = CompiledFn (*)(Value sysder, Value state, const char *who,
+                                      std::string *why_not);
+void set_system_compiler(SystemCompiler compiler);
 
 } // namespace sicm

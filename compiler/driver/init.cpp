@@ -42,6 +42,7 @@ void init_interpreter() {
   set_value_writer(write_string);
   set_expression_node_counter(expr_count);
   set_scalar_compiler(compile_for_run);
+  set_system_compiler(compile_system_for_run);
   install_special_forms();
   install_core_primitives();
   install_list_primitives();

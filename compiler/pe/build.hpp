@@ -42,6 +42,13 @@ bool in_build_mode();
 // works). The interpreter's heap is as it was either way. who: the
 // primitive that asks (for messages). See pe/for_run.cpp.
 // Given to the numerical primitives at start-up (set_scalar_compiler).
-CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not);
+CompiledFn compile_for_run(Value f, const char *who, std::string *why_not);
+
+// sicm run: a system derivative that the kernel tracer cannot compile (it
+// tests the state) compiled by the partial evaluator for states shaped like
+// `state`, as sicm build compiles it: writes the derivative's leaves for the
+// state's leaves. Null with the reason in *why_not when it cannot be, as
+// compile_for_run. Given at start-up (set_system_compiler).
+CompiledFn compile_system_for_run(Value sysder, Value state, const char *who, std::string *why_not);
 
 } // namespace sicm

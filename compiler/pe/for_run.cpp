@@ -1,18 +1,20 @@
 // sicm run's compiled procedures: a procedure of one real (bisect's
-// function) compiled by sicm build's partial evaluator into a C function, as
-// a built program compiles it, and loaded into the running process.
+// function), or a system derivative that tests the state, compiled by sicm
+// build's partial evaluator into a C function, as a built program compiles
+// it, and loaded into the running process.
 //
 // Why: the function the book gives bisect in section 4.6.1 (which-way?)
 // iterates a map thousands of times per call, in a loop whose exit depends
-// on the argument. The kernel tracer (codegen/trace.cpp) compiles only
-// straight-line arithmetic, and the interpreter takes minutes where the
-// built program takes seconds.
+// on the argument; a system derivative with a piecewise force tests the
+// state. The kernel tracer (codegen/trace.cpp) compiles only straight-line
+// arithmetic, and the interpreter takes minutes where the built program
+// takes seconds.
 //
 // How: build mode is switched on for the trace alone (begin_build_mode ...
 // end_build_mode) with a residual program of its own; the procedure is
 // traced into one function exactly as sicm build traces bisect's function
-// (trace_scalar); the function is written as a C unit that needs no runtime
-// (emit_residual_function) and loaded by the JIT.
+// (trace_scalar) or a system derivative (trace_system_function); the function is written as a C
+// unit that needs no runtime (emit_residual_function) and loaded by the JIT.
 //
 // The trace runs the procedure once, at compile time, in the interpreter's
 // own heap, so nothing it does may outlive it, and nothing the procedure
@@ -28,6 +30,7 @@
 // program prints except in the last digits a different order of floating
 // point operations can change (as between sicm run and sicm build).
 #include <cstring>
+#include <functional>
 #include <string>
 
 #include "base/limits.hpp"
@@ -137,7 +140,14 @@ bool calls_runtime(const std::string &c) {
 } // namespace
 } // namespace build
 
-CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not) {
+namespace {
+
+// What compile_for_run and compile_system_for_run share: `trace` traces the
+// procedure into a function of a residual program of its own and returns
+// its id; that function, if it is all arithmetic, tests and loops, is
+// emitted and loaded.
+CompiledFn compile_traced_for_run(Value proc, const std::function<int()> &trace,
+                                  std::string *why_not) {
   using namespace build;
   if (in_build_mode()) {
     *why_not = "sicm build compiles it with the program";
@@ -157,7 +167,7 @@ CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not)
     } keep;
     try {
       TraceForRun build;
-      id = trace_scalar(f, who);
+      id = trace();
       program = std::move(build.program());
     } catch (const Error &e) {
       if (std::string_view(e.what()) == "Interrupted") throw;
@@ -168,7 +178,7 @@ CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not)
       return nullptr;
     }
   }
-  program.source_name = procedure_name(f);
+  program.source_name = procedure_name(proc);
   if (program.functions.size() != 2 || !program.functions[0].body.empty() ||
       !program.cells.empty() || !program.lists.empty() || program.plots != 0 ||
       !only_arithmetic(program.functions[id].body)) {
@@ -186,7 +196,20 @@ CompiledScalarFn compile_for_run(Value f, const char *who, std::string *why_not)
     *why_not = "it needs the runtime";
     return nullptr;
   }
-  return reinterpret_cast<CompiledScalarFn>(jit_load(c, kEntry, nullptr, why_not));
+  return reinterpret_cast<CompiledFn>(jit_load(c, kEntry, nullptr, why_not));
+}
+
+} // namespace
+
+CompiledFn compile_for_run(Value f, const char *who, std::string *why_not) {
+  return compile_traced_for_run(
+      f, [&] { return build::trace_scalar(f, who); }, why_not);
+}
+
+CompiledFn compile_system_for_run(Value sysder, Value state, const char *who,
+                                  std::string *why_not) {
+  return compile_traced_for_run(
+      sysder, [&] { return build::trace_system_function(sysder, state, who); }, why_not);
 }
 
 } // namespace sicm

@@ -365,11 +365,13 @@ std::vector<ExprId> system_outputs(const gcvec<Value> &leaves, const char *who) 
   return outputs;
 }
 
-// Trace a system derivative on a state shaped like `state`; fills the
-// statement's callee, time_first and rate_one. The derivative takes the
-// form the interpreter's compiled derivatives take (kernel_outputs: evolve
-// in `sicm run` compiles the same kernel, so both compute the same numbers).
-void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
+} // namespace
+
+// A system derivative traced into a new function of the state's leaves
+// whose outputs are the derivative's leaves, in the form the interpreter's
+// compiled derivatives take (kernel_outputs: evolve in `sicm run` compiles
+// the same kernel, so both compute the same numbers). Returns its id.
+int trace_system_function(Value sysder, Value state, const char *who) {
   if (!is_state_shape(state)) wrong_type(state, 1, who);
   FunctionScope scope(procedure_name(sysder));
   gcvec<Value> x{input_like(state)};
@@ -381,11 +383,19 @@ void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
                                describe(state));
   std::vector<ExprId> outputs = system_outputs(leaves, who);
   current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
-  s.callee = scope.id();
+  return scope.id();
+}
+
+namespace {
+
+// Trace a system derivative on a state shaped like `state`; fills the
+// statement's callee, time_first and rate_one.
+void trace_system(Value sysder, Value state, RStmt &s, const char *who) {
+  s.callee = trace_system_function(sysder, state, who);
   size_t len;
   Value *items = container_items(state, &len);
   s.time_first = items && !container_items(items[0], &len);
-  ExprId d0 = current().outputs[0];
+  ExprId d0 = g_build->program.functions[s.callee].outputs[0];
   s.rate_one =
       expr_is_exact_one(d0) || (expr_kind(d0) == ExprKind::Flonum && expr_node(d0).d == 1.0);
 }

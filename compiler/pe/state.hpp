@@ -219,6 +219,9 @@ int in_new_function(const std::string &name, const std::function<void()> &body);
 // Trace a scalar function (integrand, objective, function with a root) into
 // a new function of one input and one output; returns its id.
 int trace_scalar(Value f, const char *who);
+// Trace a system derivative into a new function from the leaves of a state
+// shaped like `state` to the leaves of its derivative; returns its id.
+int trace_system_function(Value sysder, Value state, const char *who);
 // A value shaped like `sample` (a number, or an up/down structure of them)
 // whose leaves are fresh inputs of the open function.
 Value input_like(Value sample);

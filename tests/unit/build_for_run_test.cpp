@@ -27,11 +27,11 @@ Value run(const std::string &text) {
   return v;
 }
 
-CompiledScalarFn compile(const std::string &proc, std::string *why) {
+CompiledFn compile(const std::string &proc, std::string *why) {
   return compile_for_run(run(proc), "bisect", why);
 }
 
-double call(CompiledScalarFn fn, double x) {
+double call(CompiledFn fn, double x) {
   double out = NAN;
   EXPECT_EQ(fn(&x, &out, interrupt_flag()), 0) << "at " << x;
   return out;
@@ -40,10 +40,10 @@ double call(CompiledScalarFn fn, double x) {
 TEST(CompileForRun, LoopWhoseExitDependsOnTheArgument) {
   // Halve x until it is below 1: the count of halvings, minus 3.
   std::string why;
-  CompiledScalarFn fn = compile("(lambda (x)"
-                                "  (let loop ((x x) (n 0))"
-                                "    (if (< x 1.) (- n 3) (loop (/ x 2.) (+ n 1)))))",
-                                &why);
+  CompiledFn fn = compile("(lambda (x)"
+                          "  (let loop ((x x) (n 0))"
+                          "    (if (< x 1.) (- n 3) (loop (/ x 2.) (+ n 1)))))",
+                          &why);
   ASSERT_NE(fn, nullptr) << why;
   EXPECT_EQ(call(fn, 0.5), -3.0);
   EXPECT_EQ(call(fn, 5.0), 0.0);    // 5 -> 2.5 -> 1.25 -> 0.625
@@ -53,14 +53,14 @@ TEST(CompileForRun, LoopWhoseExitDependsOnTheArgument) {
 TEST(CompileForRun, ClosureOverKnownValues) {
   run("(define (make-shifted c) (lambda (x) (- (* x x) c)))");
   std::string why;
-  CompiledScalarFn fn = compile("(make-shifted 2)", &why);
+  CompiledFn fn = compile("(make-shifted 2)", &why);
   ASSERT_NE(fn, nullptr) << why;
   EXPECT_EQ(call(fn, 3.0), 7.0);
 }
 
 TEST(CompileForRun, CheckedOperationLeavesTheValueToTheInterpreter) {
   std::string why;
-  CompiledScalarFn fn = compile("(lambda (x) (/ 1. (- x 2.)))", &why);
+  CompiledFn fn = compile("(lambda (x) (/ 1. (- x 2.)))", &why);
   ASSERT_NE(fn, nullptr) << why;
   double x = 2.0, out = 0;
   EXPECT_EQ(fn(&x, &out, interrupt_flag()), 1); // division by zero: the interpreter raises it
@@ -76,8 +76,7 @@ TEST(CompileForRun, CheckedOperationLeavesTheValueToTheInterpreter) {
 TEST(CompileForRun, InterruptEndsACompiledLoop) {
   // A loop that never ends: Ctrl-C (in the REPL) must still stop it.
   std::string why;
-  CompiledScalarFn fn =
-      compile("(lambda (x) (let loop ((y x)) (if (< y 0.) y (loop (+ y 1.)))))", &why);
+  CompiledFn fn = compile("(lambda (x) (let loop ((y x)) (if (< y 0.) y (loop (+ y 1.)))))", &why);
   ASSERT_NE(fn, nullptr) << why;
   request_interrupt();
   double x = 1.0, out = 0;
@@ -118,7 +117,7 @@ TEST(CompileForRun, OnlyWhatTheProcedureMadeMayChange) {
   EXPECT_EQ(compile("(lambda (x) (append! outer (list x)) x)", &why), nullptr);
   EXPECT_EQ(write_string(run("outer")), "(1 2)");
   // A pair it makes, even one whose tail is an outer list, it may change.
-  CompiledScalarFn fn =
+  CompiledFn fn =
       compile("(lambda (x) (let ((p (cons 0. outer))) (set-car! p x) (* 2. (car p))))", &why);
   ASSERT_NE(fn, nullptr) << why;
   EXPECT_EQ(call(fn, 3.0), 6.0);
@@ -138,6 +137,41 @@ TEST(CompileForRun, NumericalPrimitivesInsideAreRefused) {
   std::string why;
   EXPECT_EQ(compile("(lambda (x) (- (definite-integral (lambda (t) (* t t)) 0. x) 1.))", &why),
             nullptr);
+  EXPECT_FALSE(in_build_mode());
+}
+
+// A system derivative that tests the state: the kernel tracer cannot
+// compile it, the partial evaluator can, for states of the given shape.
+CompiledFn compile_system(const std::string &proc, const std::string &state, std::string *why) {
+  return compile_system_for_run(run(proc), run(state), "state-advancer", why);
+}
+
+TEST(CompileSystemForRun, PiecewiseForceTakesTheBranchOfEachState) {
+  std::string why;
+  CompiledFn fn = compile_system("(lambda (s)"
+                                 "  (let ((x (ref s 1)) (v (ref s 2)))"
+                                 "    (up 1 v (if (> x 0) (* -1 x) (* -4 x)))))",
+                                 "(up 0. 0. 1.)", &why);
+  ASSERT_NE(fn, nullptr) << why;
+  double out[3] = {0, 0, 0};
+  double right[3] = {0.0, 0.5, 2.0};
+  ASSERT_EQ(fn(right, out, interrupt_flag()), 0);
+  EXPECT_EQ(out[0], 1.0);
+  EXPECT_EQ(out[1], 2.0);
+  EXPECT_EQ(out[2], -0.5); // x > 0: -x
+  double left[3] = {0.0, -0.5, 2.0};
+  ASSERT_EQ(fn(left, out, interrupt_flag()), 0);
+  EXPECT_EQ(out[2], 2.0); // x < 0: -4x
+}
+
+TEST(CompileSystemForRun, EffectsAreRefusedAndNotDone) {
+  run("(define evaluations 0)");
+  std::string why;
+  EXPECT_EQ(compile_system("(lambda (s) (set! evaluations (+ evaluations 1))"
+                           "  (up 1 (if (> (ref s 1) 0) 1. 2.)))",
+                           "(up 0. 0.)", &why),
+            nullptr);
+  EXPECT_EQ(write_string(run("evaluations")), "0");
   EXPECT_FALSE(in_build_mode());
 }
 

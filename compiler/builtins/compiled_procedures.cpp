@@ -1,0 +1,111 @@
+// Which procedures given to sicm run's numerical primitives run compiled
+// (see compiled_procedures.hpp).
+#include "builtins/compiled_procedures.hpp"
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "base/error.hpp"
+#include "base/primitive.hpp"
+#include "eval/procedure.hpp"
+
+namespace sicm {
+
+namespace {
+
+// Recent (procedure, shape) -> compiled pairs are remembered, because a
+// state advancer inside a map is called over and over with the same
+// procedure.
+struct CompiledSysder {
+  Value sysder;
+  Value state_shape;    // a sample state
+  const Kernel *kernel; // null: not traceable
+  bool taylor;          // compiled with its Taylor coefficients (if it has them)
+  // When there is no kernel: the derivative compiled by the partial
+  // evaluator (it tests the state), once tried; null if it cannot be.
+  bool residual_tried = false;
+  CompiledFn residual = nullptr;
+};
+gcvec<CompiledSysder> g_compiled; // static, hence a root for the collector
+constexpr size_t kCompiledMemo = 32;
+// Each compiled procedure is a shared object loaded for good (and a root
+// set of the collector); a parameter sweep that makes a new system per
+// point would load thousands. Past this many, procedures are interpreted.
+constexpr size_t kMaxAutoKernels = 64;
+size_t g_auto_kernels = 0;
+
+ScalarCompiler g_scalar_compiler = nullptr;
+SystemCompiler g_system_compiler = nullptr;
+
+bool kernels_enabled() {
+  static const bool enabled = [] {
+    const char *e = std::getenv("SICM_INTERPRET");
+    return !(e && *e && std::strcmp(e, "0") != 0);
+  }();
+  return enabled;
+}
+
+} // namespace
+
+const Kernel *auto_kernel(Value sysder, Value state, size_t dim, bool taylor) {
+  if (!kernels_enabled() || !is_procedure(sysder)) return nullptr;
+  for (const CompiledSysder &c : g_compiled)
+    if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape) && (c.taylor || !taylor))
+      return c.kernel;
+  if (g_auto_kernels >= kMaxAutoKernels) return nullptr;
+  std::string why;
+  KernelOptions options{.probe_singularities = true, .taylor = taylor};
+  const Kernel *k = compile_kernel(sysder, list({state}), "system_derivative", &why, options);
+  if (k) ++g_auto_kernels;
+  if (k && (k->nin != dim || k->nout != dim)) k = nullptr;
+  if (g_compiled.size() >= kCompiledMemo) g_compiled.erase(g_compiled.begin());
+  g_compiled.push_back(CompiledSysder{sysder, state, k, taylor});
+  return k;
+}
+
+CompiledFn auto_residual(Value sysder, Value state, const char *who) {
+  if (!kernels_enabled() || !g_system_compiler) return nullptr;
+  CompiledSysder *entry = nullptr;
+  for (CompiledSysder &c : g_compiled)
+    if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape) && !c.kernel) entry = &c;
+  if (!entry || entry->residual_tried) return entry ? entry->residual : nullptr;
+  entry->residual_tried = true;
+  if (g_auto_kernels >= kMaxAutoKernels) return nullptr;
+  std::string why;
+  entry->residual = g_system_compiler(sysder, state, who, &why);
+  if (entry->residual) ++g_auto_kernels;
+  return entry->residual;
+}
+
+const Kernel *jacobian_kernel(Value sysder, Value state, size_t dim) {
+  if (!kernels_enabled()) return nullptr;
+  Symbol *d = intern("D").symbol();
+  if (!d->bound) return nullptr;
+  try {
+    Value dsys = apply_procedure(d->global, &sysder, 1);
+    std::string why;
+    const Kernel *k = compile_kernel(dsys, list({state}), "jacobian", &why);
+    return k && k->nin == dim && k->nout == dim * dim ? k : nullptr;
+  } catch (const Error &) {
+    return nullptr;
+  }
+}
+
+CompiledFn compile_expensive_function(Value f, const char *who) {
+  if (!kernels_enabled() || g_auto_kernels >= kMaxAutoKernels || !g_scalar_compiler) return nullptr;
+  std::string why_not;
+  CompiledFn fn = g_scalar_compiler(f, who, &why_not);
+  if (fn) ++g_auto_kernels;
+  return fn;
+}
+
+void set_scalar_compiler(ScalarCompiler compiler) {
+  g_scalar_compiler = compiler;
+}
+
+void set_system_compiler(SystemCompiler compiler) {
+  g_system_compiler = compiler;
+}
+
+} // namespace sicm
