@@ -170,17 +170,24 @@ Value complex_log(Value z) {
   return make_rectangular(re, num_angle(z));
 }
 
-// sqrt of a recnum or of a negative real. A negative real's root is i times
-// the root of its magnitude (exact when that is: (sqrt -4) is +2i); a pure
-// imaginary iy has the root s(1 + i sign y) with s = sqrt(|y|/2), exact when
-// that is ((sqrt +2i) is 1+i); any other z has the root of its magnitude at
-// half its angle.
+// sqrt of a recnum or of a negative real, as MIT computes it. A negative
+// real's root is i times the root of its magnitude (exact when that is:
+// (sqrt -4) is +2i), and so is that of a negative real part with an
+// inexact zero imaginary part, whose sign it takes ((sqrt -9-0.i) is
+// 0.-3i); an imaginary iy, its real part zero exact or not, has the root
+// s(1 + i sign y) with s = sqrt(|y|/2), exact when that is ((sqrt 0.+2i)
+// is 1+i); any other z has the root of its magnitude at half its angle
+// (where cos(pi/2) would leave 6e-17 instead of the zero).
 Value complex_sqrt(Value z) {
   if (!is_recnum(z)) return make_rectangular(exact_int(0), num_sqrt(num_neg(z)));
   Value x = re_of(z), y = im_of(z);
-  if (x.tag == Tag::Fixnum && x.i == 0) {
+  if (num_is_zero(x)) {
     Value s = num_sqrt(num_div(num_abs(y), exact_int(2)));
     return make_rectangular(s, num_sign(y) < 0 ? num_neg(s) : s);
+  }
+  if (is_flonum(y) && y.d == 0 && num_sign(x) < 0) {
+    Value root = num_sqrt(num_neg(x));
+    return make_rectangular(Value::flonum(0), std::signbit(y.d) ? num_neg(root) : root);
   }
   return make_polar(num_sqrt(num_magnitude(z)), num_div(num_angle(z), exact_int(2)));
 }
