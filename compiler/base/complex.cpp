@@ -76,14 +76,24 @@ Value num_conjugate(Value z) {
   return make_rectangular(re_of(z), num_neg(im_of(z)));
 }
 
-// |z|: exact when the parts are exact and the sum of their squares is a
-// perfect square ((magnitude 3+4i) is 5); otherwise hypot, which neither
-// overflows nor underflows where the magnitude itself does not.
+// |z|. With exact parts, as MIT computes it: v sqrt(1 + (w/v)^2) for v and
+// w the larger and smaller magnitude of the parts, exact when the square
+// root is ((magnitude 3+4i) is 5; (magnitude 2+3i) is 3.6055512754639896,
+// not the (sqrt 13) = 3.605551275463989 of the sum of squares). With an
+// inexact part, hypot, which neither overflows nor underflows where the
+// magnitude itself does not.
 Value num_magnitude(Value z) {
   if (!is_number(z)) wrong_type(z, 1, "magnitude");
   if (!is_recnum(z)) return num_abs(z);
   Value x = re_of(z), y = im_of(z);
-  if (is_exact(x) && is_exact(y)) return num_sqrt(num_add(num_mul(x, x), num_mul(y, y)));
+  if (is_exact(x) && is_exact(y)) {
+    Value ax = num_abs(x), ay = num_abs(y);
+    bool x_larger = num_compare(ax, ay) >= 0;
+    Value v = x_larger ? ax : ay, w = x_larger ? ay : ax;
+    if (num_is_zero(v)) return v;
+    Value ratio = num_div(w, v);
+    return num_mul(v, num_sqrt(num_add(exact_int(1), num_mul(ratio, ratio))));
+  }
   return Value::flonum(std::hypot(to_double(x), to_double(y)));
 }
 
