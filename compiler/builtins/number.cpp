@@ -290,7 +290,7 @@ double random_flonum(double limit) {
 }
 
 Value prim_random(Value *a, int) {
-  refuse_draw("random");
+  refuse_effect("random");
   Value n = a[0];
   if (is_flonum(n)) {
     if (!(n.d > 0) || !std::isfinite(n.d)) bad_range(n, 1, "random");

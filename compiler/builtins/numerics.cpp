@@ -206,7 +206,6 @@ double real_result(const Callback &cb, Value r, const std::string &at) {
 constexpr uint64_t kCompileAfterSteps = 50000;
 
 // Compile cb's procedure by the partial evaluator (compile_for_run), once.
-// Compile cb's procedure by the partial evaluator, once.
 void compile_expensive(ScalarCallback &cb) {
   cb.compile_tried = true;
   cb.compiled = compile_expensive_function(cb.f, cb.who);

@@ -12,7 +12,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -145,9 +144,6 @@ bool is_numeric_shape(Value v) {
 Value apply_traced(Value proc, gcvec<Value> args) {
   DecimalConstants decimal; // 9.8 means 49/5 in the kernel's algebra
   KernelTracing tracing;    // a matrix of run-time values is solved, not inverted
-  // In sicm build the partial evaluator's rules for effects apply, but for
-  // random numbers, which it would draw while compiling.
-  EffectGuard effects(g_dynamic_branch_hooks ? Refused::Draws : Refused::All);
   return apply_procedure(proc, args.data(), static_cast<int>(args.size()));
 }
 
@@ -179,9 +175,9 @@ bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_n
     args.push_back(state_from_leaves(samples[i], leaves));
   }
   try {
-    // A kernel runs without the partial evaluator even in sicm build
+    // The kernel runs without the interpreter, even in sicm build
     // (compile-procedure), so no effect may happen only while tracing.
-    EffectGuard effects(Refused::All);
+    EffectGuard effects;
     return collect_outputs(apply_traced(proc, args), t, why_not);
   } catch (const Error &e) {
     *why_not = std::string("applying it to symbolic arguments failed: ") + e.what();

@@ -35,17 +35,17 @@ struct Trace {
 // derivatives): proc applied to args whose scalar leaves are the symbols
 // that stand for the kernel's inputs, with flonums entering the algebra as
 // the decimals they were written as (DecimalConstants) and divisions by
-// matrices of run-time values as solve nodes (KernelTracing), and, in
-// sicm run, effects that would happen once instead of at each call refused
-// (EffectGuard, eval/effect_guard.hpp). The caller takes the result's
-// leaves (codegen/state_shape.hpp) and gives them to kernel_outputs
-// (codegen/kernel_form.hpp). Errors propagate.
+// matrices of run-time values as solve nodes (KernelTracing). The caller
+// takes the result's leaves (codegen/state_shape.hpp) and gives them to
+// kernel_outputs (codegen/kernel_form.hpp). Errors propagate.
 Value apply_traced(Value proc, gcvec<Value> args);
 
 // Trace `proc` on arguments shaped like the elements of the list sample_args
 // (each a number or a nested up/down structure of numbers). Returns false and
 // a one-line reason in *why_not when the procedure cannot be traced. Errors
-// the procedure raises on symbolic arguments are caught and become the reason.
+// the procedure raises on symbolic arguments are caught and become the reason;
+// so do effects that would happen once, while tracing, instead of at each
+// call (EffectGuard, eval/effect_guard.hpp).
 bool trace_procedure(Value proc, Value sample_args, Trace *out, std::string *why_not);
 
 // True if v is a number or a nested up/down structure whose leaves are numbers.

@@ -10,32 +10,23 @@ namespace sicm {
 
 namespace {
 
-thread_local int g_depth = 0;       // Refused::All guards alive on this thread
-thread_local int g_draws_depth = 0; // guards of either kind
-thread_local uint32_t g_since = 0;  // g_frame_serial when the outermost began
+thread_local int g_depth = 0;      // guards alive on this thread
+thread_local uint32_t g_since = 0; // g_frame_serial when the outermost began
 
 [[noreturn]] void refuse(const std::string &what, SrcLoc loc) {
-  runtime_error(loc, what +
-                         " in a procedure being compiled into a kernel: it would happen once, "
-                         "while compiling, instead of at each call");
+  runtime_error(loc, what + " in a procedure being compiled into a kernel: it would happen once, "
+                            "while compiling, instead of at each call");
 }
 
 } // namespace
 
-EffectGuard::EffectGuard(Refused refused)
-    : outer_since_(g_since), outer_depth_(g_depth), outer_draws_depth_(g_draws_depth) {
-  ++g_draws_depth;
-  if (refused == Refused::All && g_depth++ == 0) g_since = g_frame_serial;
+EffectGuard::EffectGuard() : outer_since_(g_since), outer_depth_(g_depth) {
+  if (g_depth++ == 0) g_since = g_frame_serial;
 }
 
 EffectGuard::~EffectGuard() {
   g_depth = outer_depth_;
-  g_draws_depth = outer_draws_depth_;
   g_since = outer_since_;
-}
-
-void refuse_draw(const char *who) {
-  if (g_draws_depth > 0) refuse(who, current_call_loc());
 }
 
 void refuse_effect(const char *what) {

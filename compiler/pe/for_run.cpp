@@ -13,8 +13,9 @@
 // How: build mode is switched on for the trace alone (begin_build_mode ...
 // end_build_mode) with a residual program of its own; the procedure is
 // traced into one function exactly as sicm build traces bisect's function
-// (trace_scalar) or a system derivative (trace_system_function); the function is written as a C
-// unit that needs no runtime (emit_residual_function) and loaded by the JIT.
+// (trace_scalar) or a system derivative (trace_system_function); the
+// function is written as a C unit that needs no runtime
+// (emit_residual_function) and loaded by the JIT.
 //
 // The trace runs the procedure once, at compile time, in the interpreter's
 // own heap, so nothing it does may outlive it, and nothing the procedure
