@@ -133,9 +133,14 @@ deps:
 #   detect_stack_use_after_return=0
 #                               the GC scans the stacks for pointers; ASan's fake
 #                               stack frames would hide live objects from it
+#   LSAN_OPTIONS                where LeakSanitizer runs all the same (the
+#                               ranks mpirun starts), leaks inside Open MPI's
+#                               own libraries are not findings
+#                               (tests/sanitizer/openmpi-leaks.supp)
 #   SICM_TEST_TIMEOUT_SCALE=10  sanitized code computes 5-10 times slower
 SANENV := $(if $(SANITIZE),\
   ASAN_OPTIONS=abort_on_error=1:detect_leaks=0:detect_stack_use_after_return=0 \
+  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizer/openmpi-leaks.supp \
   UBSAN_OPTIONS=halt_on_error=1:abort_on_error=1:print_stacktrace=1 \
   SICM_TEST_TIMEOUT_SCALE=10)
 

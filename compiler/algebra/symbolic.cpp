@@ -2,6 +2,7 @@
 #include "algebra/symbolic.hpp"
 
 #include <cmath>
+#include <cstring>
 
 #include "algebra/structure.hpp"
 #include "base/number.hpp"
@@ -60,30 +61,51 @@ ExprId value_to_expr(Value v, int argpos, const char *who) {
 
 thread_local int g_decimal_constants = 0;
 
-// The exact rational of the shortest decimal that reads back as the flonum d
-// (finite): digits d1...dn and exponent e denote d1.d2...dn * 10^e.
-Value decimal_rational(double d) {
-  if (d == 0) return Value::fixnum(0);
-  char digits[32];
-  int e10 = 0;
-  size_t n = sicm_shortest_digits(digits, &e10, d);
-  digits[n] = '\0';
-  mpq_t q;
-  mpq_init(q);
-  mpz_set_str(mpq_numref(q), digits, 10);
-  int scale = e10 - static_cast<int>(n - 1); // value = digits * 10^scale
-  mpz_t p;
-  mpz_init(p);
-  mpz_ui_pow_ui(p, 10, static_cast<unsigned long>(scale < 0 ? -scale : scale));
-  if (scale < 0)
-    mpz_set(mpq_denref(q), p);
-  else
-    mpz_mul(mpq_numref(q), mpq_numref(q), p);
-  mpz_clear(p);
-  if (d < 0) mpz_neg(mpq_numref(q), mpq_numref(q));
-  Value v = make_rational(q);
-  mpq_clear(q);
-  return v;
+
+
+// ---- kernel parameters (see KernelParameters) --------------------------------------
+
+thread_local KernelParameters *g_kernel_parameters = nullptr;
+
+// A flonum that a kernel takes as a parameter: finite, and not one of the
+// values whose folding changes the kernel's structure: 0, and the small
+// multiples of 1/8 (1., -1., 2., .5, 1.5: a unit mass or length, the 1/2
+// of a kinetic energy made inexact by an inexact mass), which cancel,
+// vanish from products and keep divisions out of mass matrices when folded.
+bool parametric_flonum(Value v) {
+  if (!v.is(Tag::Flonum) || !std::isfinite(v.d)) return false;
+  double eighths = v.d * 8;
+  return !(eighths == std::floor(eighths) && std::fabs(eighths) <= 128);
+}
+
+bool captured_run_time_value(Value v) {
+  const KernelParameterHooks *hooks = g_kernel_parameters->hooks();
+  return hooks && !is_number(v) && hooks->is_captured(v);
+}
+
+// Does v depend on the kernel's inputs (a symbolic value that is not a
+// captured run-time value)?
+bool depends_on_inputs(Value v) {
+  return !is_number(v) && !captured_run_time_value(v);
+}
+
+// The arguments of an operation with the numbers and captured run-time
+// values that meet the kernel's inputs made parameters (the exponent of
+// expt stays: an integer exponent is a product). Returns args itself when
+// nothing changes.
+const Value *parameter_arguments(Op op, const Value *args, int nargs, gcvec<Value> &storage) {
+  if (!g_kernel_parameters) return args;
+  bool inputs = false;
+  for (int i = 0; i < nargs; i++)
+    inputs = inputs || depends_on_inputs(args[i]);
+  if (!inputs) return args;
+  for (int i = 0; i < nargs; i++) {
+    if (op == Op::Expt && i == 1) continue;
+    if (!parametric_flonum(args[i]) && !captured_run_time_value(args[i])) continue;
+    if (storage.empty()) storage.assign(args, args + nargs);
+    storage[i] = g_kernel_parameters->parameter_for(args[i]);
+  }
+  return storage.empty() ? args : storage.data();
 }
 
 // The arguments of an operation, with finite flonums made decimal rationals
@@ -198,6 +220,31 @@ Value fold_unary(Op op, Value x) {
 
 } // namespace
 
+// Digits d1...dn and exponent e denote d1.d2...dn * 10^e.
+Value decimal_rational(double d) {
+  if (d == 0) return Value::fixnum(0);
+  char digits[32];
+  int e10 = 0;
+  size_t n = sicm_shortest_digits(digits, &e10, d);
+  digits[n] = '\0';
+  mpq_t q;
+  mpq_init(q);
+  mpz_set_str(mpq_numref(q), digits, 10);
+  int scale = e10 - static_cast<int>(n - 1); // value = digits * 10^scale
+  mpz_t p;
+  mpz_init(p);
+  mpz_ui_pow_ui(p, 10, static_cast<unsigned long>(scale < 0 ? -scale : scale));
+  if (scale < 0)
+    mpz_set(mpq_denref(q), p);
+  else
+    mpz_mul(mpq_numref(q), mpq_numref(q), p);
+  mpz_clear(p);
+  if (d < 0) mpz_neg(mpq_numref(q), mpq_numref(q));
+  Value v = make_rational(q);
+  mpq_clear(q);
+  return v;
+}
+
 DecimalConstants::DecimalConstants() {
   ++g_decimal_constants;
 }
@@ -206,9 +253,36 @@ DecimalConstants::~DecimalConstants() {
   --g_decimal_constants;
 }
 
+KernelParameters::KernelParameters(const KernelParameterHooks *hooks)
+    : hooks_(hooks), outer_(g_kernel_parameters) {
+  g_kernel_parameters = this;
+}
+
+KernelParameters::~KernelParameters() {
+  g_kernel_parameters = outer_;
+}
+
+Value KernelParameters::parameter_for(Value v) {
+  // Equal flonums are one parameter; a run-time value is one by its expression.
+  for (size_t j = 0; j < values.size(); ++j) {
+    Value w = values[j];
+    if (v.is(Tag::Flonum) ? w.is(Tag::Flonum) && std::memcmp(&w.d, &v.d, sizeof v.d) == 0
+                          : !w.is(Tag::Flonum) && value_to_expr(w, 1, "kernel") ==
+                                                      value_to_expr(v, 1, "kernel"))
+      return Value::object(Tag::Symbol, symbols[j]);
+  }
+  size_t index = values.size();
+  Value sym = hooks_ && hooks_->make ? hooks_->make(v, index)
+                     : make_uninterned_symbol("k" + std::to_string(index));
+  values.push_back(v);
+  symbols.push_back(sym.symbol());
+  return sym;
+}
+
 Value symbolic_apply(Op op, const Value *raw_args, int nargs) {
-  gcvec<Value> decimal;
-  const Value *args = decimal_arguments(raw_args, nargs, decimal);
+  gcvec<Value> parametric, decimal;
+  const Value *args =
+      decimal_arguments(parameter_arguments(op, raw_args, nargs, parametric), nargs, decimal);
   const char *who = op_info(op).scheme_name;
   int arity = op_info(op).arity;
   bool n_ary = op == Op::Add || op == Op::Mul || op == Op::Sub || op == Op::Div;

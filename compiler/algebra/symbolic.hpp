@@ -56,12 +56,63 @@ Value expression_to_datum(Value v);
 // kernel's numbers are rounded to doubles once, at emission, so a constant
 // the user wrote reads back as exactly the double it was. Arithmetic on
 // numbers alone is untouched: (* 1.5 9.8) is still a flonum product.
+// The exact rational of the shortest decimal that reads back as the finite
+// flonum d (9.8 -> 49/5), as DecimalConstants makes it.
+Value decimal_rational(double d);
+
 class DecimalConstants {
 public:
   DecimalConstants();
   ~DecimalConstants();
   DecimalConstants(const DecimalConstants &) = delete;
   DecimalConstants &operator=(const DecimalConstants &) = delete;
+};
+
+// While a KernelParameters lives (on this thread, inside a trace: see
+// codegen/trace.hpp), a number the traced procedure brings into an operation
+// with a value that depends on the kernel's inputs becomes a parameter of
+// the kernel: a symbol standing for p[j] (the kernel ABI's third argument)
+// instead of a constant folded into the algebra. Two systems whose numbers
+// differ only in value are then one kernel: a parameter scan, a map that
+// makes a new system at every step, a Lagrangian redefined in the REPL with
+// new numbers compile once. Numbers that change a kernel's structure stay
+// constants: exact numbers, the flonums that are small multiples of 1/8
+// (0., 1., -1., 2., .5: a term with a zero coefficient vanishes, an effect
+// switched off costs nothing, a unit mass divides nothing) and exponents.
+// Equal flonums are one parameter.
+//
+// sicm build gives hooks (KernelParameterHooks), so that a value known only
+// at run time that the procedure captured (a (parameter), a result of an
+// earlier integration) is a parameter in the same way: the trace of a
+// system derivative is then the same in both modes, and so is its C.
+struct KernelParameterHooks {
+  // Is v a captured run-time value (a symbol or an expression that does not
+  // depend on the kernel's inputs)?
+  bool (*is_captured)(Value v);
+  // The symbol that stands for parameter `index`, whose value is `value`
+  // (null: an uninterned symbol named k<index>, as without hooks).
+  Value (*make)(Value value, size_t index);
+};
+
+class KernelParameters {
+public:
+  explicit KernelParameters(const KernelParameterHooks *hooks = nullptr);
+  ~KernelParameters();
+  KernelParameters(const KernelParameters &) = delete;
+  KernelParameters &operator=(const KernelParameters &) = delete;
+
+  // Parameter j: the symbol that stands for it and its value (a flonum, or
+  // with hooks a run-time value).
+  gcvec<Symbol *> symbols;
+  gcvec<Value> values;
+
+  // The parameter standing for v (made on first use); for symbolic.cpp.
+  Value parameter_for(Value v);
+  const KernelParameterHooks *hooks() const { return hooks_; }
+
+private:
+  const KernelParameterHooks *hooks_;
+  KernelParameters *outer_;
 };
 
 // Register the algebra's primitives (simplify, print-expression, pe,

@@ -99,7 +99,8 @@ Limits g_limits = {kUnlimited,
                    kUnlimited,
                    kUnlimited,
                    kMaxUnrolledElements,
-                   kMaxUnrolledIterations};
+                   kMaxUnrolledIterations,
+                   kMaxCompiledKernels};
 NodeCounter g_node_counter = nullptr;
 
 size_t node_count() {
@@ -202,6 +203,7 @@ const Flag kFlags[] = {
     {"--max-residual-size", &Limits::max_residual_size, false, true},
     {"--max-unrolled-elements", &Limits::max_unrolled_elements, false, true},
     {"--max-unrolled-iterations", &Limits::max_unrolled_iterations, false, true},
+    {"--max-compiled-kernels", &Limits::max_compiled_kernels, false, true},
 };
 
 // The largest recursion depth accepted (the stack grows with it).
@@ -297,6 +299,7 @@ Limits with_defaults(Limits given, bool compile_time) {
   if (!l.max_residual_size) l.max_residual_size = kDefaultResidualSize;
   if (!l.max_unrolled_elements) l.max_unrolled_elements = kMaxUnrolledElements;
   if (!l.max_unrolled_iterations) l.max_unrolled_iterations = kMaxUnrolledIterations;
+  if (!l.max_compiled_kernels) l.max_compiled_kernels = kMaxCompiledKernels;
   return l;
 }
 
@@ -368,7 +371,12 @@ std::string limits_usage() {
          "                            build: a loop that starts from known values and\n"
          "                            does run-time work is unrolled this far, then left\n"
          "                            for run time as a C loop; default " +
-         show_count(kMaxUnrolledIterations) + "\n";
+         show_count(kMaxUnrolledIterations) +
+         "\n"
+         "  --max-compiled-kernels=N  distinct compiled procedures (kernels that differ\n"
+         "                            in structure) one process loads; past it they are\n"
+         "                            interpreted, with a note; default " +
+         show_count(kMaxCompiledKernels) + "\n";
 }
 
 size_t recursion_stack_bytes(const Limits &limits) {

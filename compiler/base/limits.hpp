@@ -31,7 +31,15 @@ struct Limits {
   uint64_t max_residual_size = 0;       // statements of a built program
   uint64_t max_unrolled_elements = 0;   // sicm build: see kMaxUnrolledElements
   uint64_t max_unrolled_iterations = 0; // sicm build: see kMaxUnrolledIterations
+  uint64_t max_compiled_kernels = 0;    // see kMaxCompiledKernels
 };
+
+// Distinct compiled procedures (shared objects: kernels that differ in
+// structure, not only in the values of their numbers) one process loads;
+// past this many, procedures not compiled already are interpreted, and a
+// note on stderr says so once, at the user's line (--max-compiled-kernels).
+// Loaded code is never unloaded, so the limit bounds its memory.
+constexpr uint64_t kMaxCompiledKernels = 2000;
 
 // sicm build unrolls map and for-each over a list known at compile time
 // whose body does run-time work (calls a numerical primitive, plots) only

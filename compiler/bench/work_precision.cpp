@@ -44,8 +44,9 @@ struct Run {
   double error = 0;
 };
 
-int call_kernel(double, const double *y, double *dydt, void *params) {
-  (*static_cast<KernelFn *>(params))(y, dydt, nullptr);
+int call_kernel(double, const double *y, double *dydt, void *data) {
+  const IntegrationSite &site = *static_cast<const IntegrationSite *>(data);
+  site.kernel(y, dydt, site.params.empty() ? nullptr : site.params.data());
   return 0;
 }
 
@@ -56,13 +57,14 @@ void quiet(const char *, int) {}
 Run integrate_once(const IntegrationSite &site, const sicm_ode_step_type *T, double tolerance) {
   Run r;
   r.tolerance = tolerance;
-  KernelFn fn = site.kernel;
-  sicm_ode *o = sicm_ode_alloc(T, site.y.size(), call_kernel, &fn, tolerance, tolerance);
+  sicm_ode *o = sicm_ode_alloc(T, site.y.size(), call_kernel, const_cast<IntegrationSite *>(&site),
+                               tolerance, tolerance);
   r.final = site.y;
   if (!o) return r;
-  if (T == sicm_ode_step_taylor && site.taylor) sicm_ode_set_taylor(o, site.taylor, nullptr);
+  const double *p = site.params.empty() ? nullptr : site.params.data();
+  if (T == sicm_ode_step_taylor && site.taylor) sicm_ode_set_taylor(o, site.taylor, p);
   if (T == sicm_ode_step_taylor_extended && site.taylor_extended)
-    sicm_ode_set_taylor_extended(o, site.taylor_extended, nullptr);
+    sicm_ode_set_taylor_extended(o, site.taylor_extended, p);
   double t = site.t0;
   const double start = sicm_stats_clock();
   r.ok = sicm_ode_evolve(o, &t, site.t1, r.final.data()) == SICM_SUCCESS;

@@ -29,11 +29,11 @@ struct CompiledSysder {
 };
 gcvec<CompiledSysder> g_compiled; // static, hence a root for the collector
 constexpr size_t kCompiledMemo = 32;
-// Each compiled procedure is a shared object loaded for good (and a root
-// set of the collector); a parameter sweep that makes a new system per
-// point would load thousands. Past this many, procedures are interpreted.
-constexpr size_t kMaxAutoKernels = 64;
-size_t g_auto_kernels = 0;
+// There is no count here: a new system made from the same procedures with
+// other numbers is the same C (its numbers are the kernel's parameters,
+// codegen/kernel.hpp), which the JIT has loaded already; only procedures
+// that differ in structure load another shared object, and the JIT bounds
+// those (--max-compiled-kernels, base/limits.hpp).
 
 ScalarCompiler g_scalar_compiler = nullptr;
 SystemCompiler g_system_compiler = nullptr;
@@ -53,11 +53,9 @@ const Kernel *auto_kernel(Value sysder, Value state, size_t dim, bool taylor) {
   for (const CompiledSysder &c : g_compiled)
     if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape) && (c.taylor || !taylor))
       return c.kernel;
-  if (g_auto_kernels >= kMaxAutoKernels) return nullptr;
   std::string why;
   KernelOptions options{.probe_singularities = true, .taylor = taylor};
   const Kernel *k = compile_kernel(sysder, list({state}), "system_derivative", &why, options);
-  if (k) ++g_auto_kernels;
   if (k && (k->nin != dim || k->nout != dim)) k = nullptr;
   if (g_compiled.size() >= kCompiledMemo) g_compiled.erase(g_compiled.begin());
   g_compiled.push_back(CompiledSysder{sysder, state, k, taylor});
@@ -71,10 +69,8 @@ CompiledFn auto_residual(Value sysder, Value state, const char *who) {
     if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape) && !c.kernel) entry = &c;
   if (!entry || entry->residual_tried) return entry ? entry->residual : nullptr;
   entry->residual_tried = true;
-  if (g_auto_kernels >= kMaxAutoKernels) return nullptr;
   std::string why;
   entry->residual = g_system_compiler(sysder, state, who, &why);
-  if (entry->residual) ++g_auto_kernels;
   return entry->residual;
 }
 
@@ -93,11 +89,9 @@ const Kernel *jacobian_kernel(Value sysder, Value state, size_t dim) {
 }
 
 CompiledFn compile_expensive_function(Value f, const char *who) {
-  if (!kernels_enabled() || g_auto_kernels >= kMaxAutoKernels || !g_scalar_compiler) return nullptr;
+  if (!kernels_enabled() || !g_scalar_compiler) return nullptr;
   std::string why_not;
-  CompiledFn fn = g_scalar_compiler(f, who, &why_not);
-  if (fn) ++g_auto_kernels;
-  return fn;
+  return g_scalar_compiler(f, who, &why_not);
 }
 
 void set_scalar_compiler(ScalarCompiler compiler) {

@@ -23,6 +23,7 @@ struct IntegrationSite {
   KernelFn kernel;   // the system derivative (loaded code is never unloaded), or null
   TaylorFn taylor;   // its Taylor coefficients (for 'taylor), or null
   TaylorExtendedFn taylor_extended; // the same in long double (for 'taylor-extended)
+  std::vector<double> params;       // the p[] of the three functions (kernel.hpp)
   std::vector<double> y;            // the initial state's leaves
   bool time_first;                  // y[0] is the time
   double t0, t1;                    // the interval, in the integrator's time

@@ -612,7 +612,7 @@ struct OdeProblem {
       probe_texts.clear();
       for (const std::string &text : cb.kernel->singular_texts)
         probe_texts.push_back(text.c_str());
-      sicm_ode_set_singularity_probe(ode.get(), cb.kernel->singular_factors, nullptr,
+      sicm_ode_set_singularity_probe(ode.get(), cb.kernel->singular_factors, kernel_params(cb.kernel),
                                      probe_texts.size(), probe_texts.data());
     }
     if (T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended) use_taylor(ode.get(), T);
@@ -635,14 +635,14 @@ struct OdeProblem {
     }
     if (cb.kernel && cb.kernel->taylor) {
       if (T == sicm_ode_step_taylor_extended)
-        sicm_ode_set_taylor_extended(ode, cb.kernel->taylor_extended, nullptr);
+        sicm_ode_set_taylor_extended(ode, cb.kernel->taylor_extended, kernel_params(cb.kernel));
       else
-        sicm_ode_set_taylor(ode, cb.kernel->taylor, nullptr);
+        sicm_ode_set_taylor(ode, cb.kernel->taylor, kernel_params(cb.kernel));
       return;
     }
     std::string why =
         !cb.kernel ? "this one is interpreted, not compiled (it cannot be traced, SICM_INTERPRET "
-                     "is set, or too many system derivatives were compiled)"
+                     "is set, or --max-compiled-kernels was reached)"
         : cb.kernel->taylor_why_not.empty() ? "this one was compiled without them"
                                             : "this one has " + cb.kernel->taylor_why_not;
     numeric_error(cb.loc, cb.who,
@@ -658,6 +658,7 @@ struct OdeProblem {
     record_integration_site(IntegrationSite{
         loc_text(cb.loc), who, cb.kernel ? cb.kernel->fn : nullptr,
         cb.kernel ? cb.kernel->taylor : nullptr, cb.kernel ? cb.kernel->taylor_extended : nullptr,
+        cb.kernel ? cb.kernel->params : std::vector<double>(),
         y, shape.time_first(), t0, t1, eps, sicm_ode_step_type_name(T)});
   }
 

@@ -5,9 +5,11 @@
 // the default. In a built program the value stays a run-time value, so a
 // parameter sweep reuses one executable instead of compiling once per value
 // (pe/build_mode.cpp rebinds `parameter`).
+#include <algorithm>
 #include <cstdlib>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "base/number.hpp"
 #include "base/primitive.hpp"
@@ -20,6 +22,7 @@ namespace {
 
 std::map<std::string, double> g_given; // from --param, by name
 std::map<std::string, double> g_fixed; // from --fix (sicm build), by name
+std::vector<std::string> g_declared;   // the program's parameters, in declaration order
 
 // NAME=VALUE, VALUE a real number in C syntax; the option's name for messages.
 bool parse_assignment(const std::string &assignment, const char *option, std::string *name,
@@ -43,6 +46,7 @@ bool parse_assignment(const std::string &assignment, const char *option, std::st
 Value P_parameter(Value *a, int) {
   if (!is_symbol(a[0])) wrong_type(a[0], 1, "parameter");
   if (!is_number(a[1])) wrong_type(a[1], 2, "parameter");
+  declare_parameter(symbol_name(a[0]));
   auto it = g_given.find(symbol_name(a[0]));
   // Always a flonum, as a built program's run-time value is.
   return Value::flonum(it == g_given.end() ? to_double(a[1]) : it->second);
@@ -71,6 +75,26 @@ bool fixed_parameter(const std::string &name, double *value) {
   if (it == g_fixed.end()) return false;
   *value = it->second;
   return true;
+}
+
+void declare_parameter(const std::string &name) {
+  if (std::find(g_declared.begin(), g_declared.end(), name) == g_declared.end())
+    g_declared.push_back(name);
+}
+
+std::string undeclared_parameter_error() {
+  for (const auto *given : {&g_given, &g_fixed}) {
+    for (const auto &[name, value] : *given) {
+      if (std::find(g_declared.begin(), g_declared.end(), name) != g_declared.end()) continue;
+      std::string known;
+      for (const std::string &d : g_declared)
+        known += (known.empty() ? "" : ", ") + d;
+      return std::string(given == &g_given ? "--param " : "--fix ") + name +
+             "=...: the program declares no parameter " + name +
+             (known.empty() ? " (it declares none)" : " (its parameters: " + known + ")");
+    }
+  }
+  return "";
 }
 
 void install_parameter_primitives() {

@@ -17,6 +17,16 @@ bool fix_parameter_option(const std::string &assignment, std::string *why_not);
 // The value --fix gave the parameter `name`, if it did.
 bool fixed_parameter(const std::string &name, double *value);
 
+// Note that the program declares the parameter `name` ((parameter 'name
+// default) was evaluated, in sicm run or in sicm build).
+void declare_parameter(const std::string &name);
+
+// After the program: "" if every --param and --fix names a parameter it
+// declared, else the error, naming the first such option and the
+// parameters the program has (as the executables of sicm build refuse an
+// unknown --param).
+std::string undeclared_parameter_error();
+
 // (parameter name default). Called by init_interpreter.
 
 } // namespace sicm

@@ -757,7 +757,12 @@ std::string emit_kernel_function(const Trace &t, const std::string &c_name, bool
   for (size_t i = 0; i < t.inputs.size(); ++i)
     input[t.inputs[i]] = i;
   bool uses_in = false;
+  std::unordered_map<Symbol *, size_t> param;
+  for (size_t j = 0; j < t.param_symbols.size(); ++j)
+    param[t.param_symbols[j]] = j;
   auto spell = [&](Symbol *s) {
+    auto k = param.find(s);
+    if (k != param.end()) return "p[" + std::to_string(k->second) + "]";
     auto in = input.find(s);
     SICM_ASSERT(in != input.end()); // trace_procedure checked the symbols
     uses_in = true;

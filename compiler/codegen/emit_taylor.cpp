@@ -267,6 +267,10 @@ private:
         constant += (constant.empty() ? "" : " * ") + scalar(a);
     }
     std::string scale = constant.empty() ? "" : "(" + constant + ") * ";
+    if (factors.empty()) { // a product of parameters, a series in extended precision
+      line(v + "[k] = k == 0 ? " + constant + " : 0;");
+      return true;
+    }
     if (factors.size() == 1) {
       line(v + "[k] = " + scale + factors[0] + "[k];");
       return true;
@@ -443,6 +447,9 @@ private:
   // give up, since it cannot be evaluated here.
   std::function<std::string(Symbol *)> spell_symbol() {
     return [this](Symbol *sym) -> std::string {
+      // The trace's own parameters are the kernel's p[j].
+      for (size_t j = 0; j < t_.param_symbols.size(); ++j)
+        if (t_.param_symbols[j] == sym) return "p[" + std::to_string(j) + "]";
       std::string s = spell_ ? spell_(sym) : "";
       if (s.empty()) {
         if (why_not_.empty()) why_not_ = "a value that is not known where the coefficients are";

@@ -43,6 +43,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "base/error.hpp"
+#include "base/limits.hpp"
+
 extern char **environ;
 
 namespace sicm {
@@ -485,6 +488,30 @@ void *loaded_handle(const std::string &so) {
   return h == g_handles.end() ? nullptr : h->second;
 }
 
+// Is there room for one more shared object under --max-compiled-kernels?
+// When there is not, the first refusal says so on stderr, at the user's line.
+bool may_load_another(std::string *why_not) {
+  uint64_t limit = current_limits().max_compiled_kernels;
+  size_t loaded;
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    loaded = g_handles.size();
+  }
+  if (limit == kUnlimited || loaded < limit) return true;
+  *why_not = "the process has compiled " + std::to_string(loaded) +
+             " distinct procedures (--max-compiled-kernels)";
+  static std::atomic<bool> told{false};
+  if (!told.exchange(true)) {
+    SrcLoc loc = current_call_loc().known() ? current_call_loc() : current_toplevel_loc();
+    std::fprintf(stderr,
+                 "%s: note: %zu procedures that differ in structure have been compiled, the "
+                 "limit (--max-compiled-kernels=%llu); procedures not compiled yet are "
+                 "interpreted from here on, more slowly\n",
+                 loc_text(loc).c_str(), loaded, static_cast<unsigned long long>(limit));
+  }
+  return false;
+}
+
 // Verify the entry at so for key and dlopen it. Null with a reason in
 // *error if it is not a good entry or does not load.
 void *load_entry(const std::string &so, const Digest &key, std::string *error) {
@@ -564,6 +591,7 @@ void *jit_load(const std::string &c_source, const std::string &symbol, std::stri
   if (so_path) *so_path = so;
   void *handle = loaded_handle(so);
   std::string error;
+  if (!handle && !may_load_another(why_not)) return nullptr;
   if (!handle) handle = load_entry(so, key, &error);
   if (!handle) { // not cached, or the entry is bad or does not load: build it anew, once
     if (!compile_to(dir, name, key, c_source, cc, so, why_not)) return nullptr;

@@ -27,8 +27,12 @@
 // The ABI of every kernel: void NAME(const double *in, double *out, const
 // double *p), in[] the arguments' scalar leaves in order (depth first, left to
 // right, argument after argument), out[] the result's leaves in the same
-// order, p reserved for parameters that stay dynamic (unused for now: callers
-// pass null).
+// order, p[] the numbers the procedure captured (its parameters, in the
+// order the trace met them: KernelParameters, algebra/symbolic.hpp). Two
+// procedures whose numbers differ only in value have the same C, so a
+// scan over a parameter compiles and loads one shared object; every
+// function of a kernel (derivative, singular factors, Taylor coefficients)
+// takes the same p[].
 #pragma once
 
 #include <cstddef>
@@ -68,7 +72,14 @@ struct Kernel {
   TaylorFn taylor = nullptr;
   TaylorExtendedFn taylor_extended = nullptr;
   std::string taylor_why_not;
+  // The values of p[] for every function above.
+  std::vector<double> params;
 };
+
+// The p[] to pass to k's functions (null when it has no parameters).
+inline const double *kernel_params(const Kernel *k) {
+  return k->params.empty() ? nullptr : k->params.data();
+}
 
 // What compile_kernel makes besides the kernel, for a system derivative
 // (whose one argument is the state).

@@ -3,6 +3,9 @@
 
 #include <map>
 #include <regex>
+#include <unordered_map>
+
+#include "codegen/singular_factors.hpp"
 
 namespace sicm {
 
@@ -80,8 +83,15 @@ const char *kind_name(RKind k) {
 class Dumper {
 public:
   explicit Dumper(const ResidualProgram &p) : p_(p) {
-    for (const RVar &v : p.vars)
-      names_[v.sym->name] = "r" + std::to_string(v.id);
+    for (const RVar &v : p.vars) {
+      std::string marker = "__sicm_rt" + std::to_string(v.id) + "__";
+      names_[marker] = "r" + std::to_string(v.id);
+      // Variables named otherwise (a kernel's inputs x0 ... and parameters
+      // k0 ..., named as sicm run names them: pe/numerics.cpp) are spelled
+      // through a marker too.
+      if (v.sym->name != marker)
+        renamed_[expr_symbol(v.sym)] = expr_symbol(make_uninterned_symbol(marker).symbol());
+    }
   }
 
   std::string run() {
@@ -107,7 +117,8 @@ private:
   std::string exprs(const std::vector<ExprId> &ids) {
     std::string s;
     for (ExprId e : ids)
-      s += (s.empty() ? "" : " ") + spelled(expr_debug_string(e), names_);
+      s += (s.empty() ? "" : " ") +
+           spelled(expr_debug_string(renamed_.empty() ? e : with_leaves({e}, renamed_)[0]), names_);
     return s;
   }
 
@@ -172,6 +183,7 @@ private:
     return out;
   }
 
+  std::unordered_map<ExprId, ExprId> renamed_;
   const ResidualProgram &p_;
   std::map<std::string, std::string> names_;
   std::string out_;

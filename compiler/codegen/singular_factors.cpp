@@ -167,6 +167,15 @@ std::vector<ExprId> with_inputs(const std::vector<ExprId> &factors,
   return out;
 }
 
+std::vector<ExprId> with_leaves(const std::vector<ExprId> &values,
+                                const std::unordered_map<ExprId, ExprId> &leaves) {
+  std::unordered_map<ExprId, ExprId> done(leaves);
+  std::vector<ExprId> out;
+  for (ExprId v : values)
+    out.push_back(substituted(v, done));
+  return out;
+}
+
 SingularFactors singular_factors(const std::vector<ExprId> &outputs,
                                  const std::function<std::string(Symbol *)> &name_of) {
   Collector c(name_of);

@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "cas/expr.hpp"
@@ -49,5 +50,12 @@ SingularFactors singular_factors(const std::vector<ExprId> &outputs,
 // symbol of `to` at the same place (for a residual function of its own).
 std::vector<ExprId> with_inputs(const std::vector<ExprId> &factors,
                                 const std::vector<Symbol *> &from, const std::vector<Symbol *> &to);
+
+// The expressions with each node that is a key of `leaves` replaced by its
+// value: a kernel's outputs with its parameters' values in place of them,
+// so that what it divides by factors and reads as it did with the numbers
+// folded in.
+std::vector<ExprId> with_leaves(const std::vector<ExprId> &values,
+                                const std::unordered_map<ExprId, ExprId> &leaves);
 
 } // namespace sicm

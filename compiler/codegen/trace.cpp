@@ -118,6 +118,7 @@ bool collect_outputs(Value result, Trace *t, std::string *why_not) {
     return false;
   }
   std::unordered_set<Symbol *> inputs(t->inputs.begin(), t->inputs.end());
+  inputs.insert(t->param_symbols.begin(), t->param_symbols.end());
   auto allowed = [&](ExprId id) {
     ExprKind kind = expr_kind(id);
     if (kind == ExprKind::Symbol) return inputs.count(expr_node(id).sym) > 0;
@@ -178,7 +179,14 @@ bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_n
     // The kernel runs without the interpreter, even in sicm build
     // (compile-procedure), so no effect may happen only while tracing.
     EffectGuard effects;
-    return collect_outputs(apply_traced(proc, args), t, why_not);
+    Value result;
+    {
+      KernelParameters params;
+      result = apply_traced(proc, args);
+      t->param_symbols = params.symbols;
+      t->params = params.values;
+    }
+    return collect_outputs(result, t, why_not);
   } catch (const Error &e) {
     *why_not = std::string("applying it to symbolic arguments failed: ") + e.what();
     return false;
@@ -266,12 +274,16 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
     std::unordered_map<Symbol *, std::string> names;
     for (size_t i = 0; i < t.inputs.size() && i < paths.size(); ++i)
       names[t.inputs[i]] = paths[i];
-    factors = singular_factors(t.outputs, [&](Symbol *s) {
+    std::unordered_map<ExprId, ExprId> values; // the parameters' values folded in again
+    for (size_t j = 0; j < t.param_symbols.size(); ++j)
+      values[expr_symbol(t.param_symbols[j])] =
+          expr_from_number(decimal_rational(to_double(t.params[j])));
+    factors = singular_factors(with_leaves(t.outputs, values), [&](Symbol *s) {
       auto it = names.find(s);
       return it == names.end() ? std::string() : it->second;
     });
     if (!factors.values.empty()) {
-      Trace probe{t.inputs, factors.values, Value::fixnum(0)};
+      Trace probe{t.inputs, factors.values, Value::fixnum(0), {}, {}};
       source += "\nvoid " + probe_name + "(const double *in, double *out, const double *p);\n\n";
       source += emit_kernel_function(probe, probe_name, false);
     }
@@ -318,13 +330,15 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   k->taylor = reinterpret_cast<TaylorFn>(taylor_fn);
   k->taylor_extended = reinterpret_cast<TaylorExtendedFn>(extended_fn);
   k->taylor_why_not = std::move(taylor_why_not);
+  for (Value v : t.params)
+    k->params.push_back(to_double(v));
   if (!agrees_at_sample(k, proc, sample_args, why_not)) return nullptr;
   if (g_kernel_listener) g_kernel_listener(k);
   return k;
 }
 
 void kernel_call(const Kernel *k, const double *in, double *out) {
-  k->fn(in, out, nullptr);
+  k->fn(in, out, kernel_params(k));
 }
 
 Value kernel_result_value(const Kernel *k, const double *out) {

@@ -46,6 +46,7 @@
 
 #include "base/srcloc.hpp"
 #include "builtins/effects_used.hpp"
+#include "builtins/parameter.hpp"
 #include "builtins/plot.hpp"
 #include "codegen/kernel.hpp"
 #include "codegen/kernel_report.hpp"
@@ -65,6 +66,7 @@ namespace {
 
 constexpr int kExitNoInput = 66;   // EX_NOINPUT
 constexpr int kExitCantCreat = 73; // EX_CANTCREAT
+constexpr int kExitUsage = 64;     // EX_USAGE: a --param or --fix of no parameter
 
 // Register the file's text as a source; false (after a message) if it cannot be read.
 bool read_source(const std::string &path, uint32_t *file) {
@@ -92,13 +94,23 @@ void collect_kernel(const Kernel *k) {
   g_emitted += "/* ---- kernel " + k->c_name + " ---- */\n" + k->c_source + "\n";
 }
 
+// --param and --fix must name parameters the program declared: a
+// misspelt name would otherwise be ignored in silence.
+int check_parameter_options() {
+  std::string error = undeclared_parameter_error();
+  if (error.empty()) return 0;
+  flush_output();
+  std::fprintf(stderr, "sicm: error: %s\n", error.c_str());
+  return kExitUsage;
+}
+
 } // namespace
 
 int run_program(const std::string &path) {
   uint32_t file;
   if (!read_source(path, &file)) return kExitNoInput;
   run_source(file);
-  return 0;
+  return check_parameter_options();
 }
 
 int run_quietly(const std::string &path) {
@@ -156,6 +168,7 @@ int build_program(const BuildOptions &o) {
   ResidualProgram &program = build.program();
   program.source_name = base_name(o.input);
   run_source(file);
+  if (int status = check_parameter_options()) return status;
   if (o.dump == "residual") {
     std::fputs(dump_residual(program).c_str(), stdout);
     return 0;

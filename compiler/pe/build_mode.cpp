@@ -317,7 +317,9 @@ void read_cells() {
 // Run a numerical primitive, tracing it again whenever a traced procedure
 // turns a global into a cell (or widens a cell from counts to reals).
 ProgramMark mark_program() {
-  return {g_build->program.functions.size(), g_build->program.vars.size(), current().body.size()};
+  std::vector<RStmt> *block = g_build->blocks.empty() ? nullptr : g_build->blocks.back();
+  return {g_build->program.functions.size(), g_build->program.vars.size(), current().body.size(),
+          block, block ? block->size() : 0};
 }
 
 void rewind_program(const ProgramMark &mark) {
@@ -327,6 +329,10 @@ void rewind_program(const ProgramMark &mark) {
   g_build->program.vars.resize(mark.nvars);
   std::vector<RStmt> &body = current().body;
   body.erase(body.begin() + static_cast<long>(mark.nbody), body.end());
+  // A block of an alternative or a loop that was current (kernel
+  // parameters are defined there: pe/numerics.cpp).
+  if (mark.block && mark.block->size() > mark.nblock)
+    mark.block->erase(mark.block->begin() + static_cast<long>(mark.nblock), mark.block->end());
 }
 
 Value with_retrace(const std::function<Value()> &body) {
@@ -599,6 +605,7 @@ Value P_runtime(Value *, int) {
 Value P_parameter(Value *a, int) {
   if (!is_symbol(a[0])) wrong_type(a[0], 1, "parameter");
   if (!is_number(a[1])) wrong_type(a[1], 2, "parameter");
+  declare_parameter(symbol_name(a[0]));
   double fixed;
   if (fixed_parameter(symbol_name(a[0]), &fixed)) return Value::flonum(fixed);
   if (g_build->open.size() > 1)

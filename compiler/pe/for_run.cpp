@@ -143,6 +143,21 @@ bool calls_runtime(const std::string &c) {
 
 namespace {
 
+// A system derivative's trace defines its kernel parameters in the caller
+// (pe/numerics.cpp); here the caller is only the frame of the trace, and
+// the values are numbers, so the definitions move to the start of the
+// function, which then needs nothing from outside.
+void inline_kernel_parameters(ResidualProgram &program, int id) {
+  std::vector<RStmt> &outer = program.functions[0].body;
+  for (const RStmt &s : outer)
+    if (s.kind != RKind::Let || s.compute != RCompute::Expr) return;
+  for (const RStmt &s : outer)
+    program.vars[s.var].function = id;
+  std::vector<RStmt> &body = program.functions[id].body;
+  body.insert(body.begin(), outer.begin(), outer.end());
+  outer.clear();
+}
+
 // What compile_for_run and compile_system_for_run share: `trace` traces the
 // procedure into a function of a residual program of its own and returns
 // its id; that function, if it is all arithmetic, tests and loops, is
@@ -180,6 +195,7 @@ CompiledFn compile_traced_for_run(Value proc, const std::function<int()> &trace,
     }
   }
   program.source_name = procedure_name(proc);
+  if (program.functions.size() == 2) inline_kernel_parameters(program, id);
   if (program.functions.size() != 2 || !program.functions[0].body.empty() ||
       !program.cells.empty() || !program.lists.empty() || program.plots != 0 ||
       !only_arithmetic(program.functions[id].body)) {

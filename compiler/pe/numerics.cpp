@@ -6,11 +6,14 @@
 // program, which the statement calls. Part of build mode (the design is in
 // pe/build_mode.cpp; the shared declarations in pe/state.hpp).
 #include <cmath>
+#include <exception>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "algebra/generic.hpp"
 #include "algebra/linear_solve.hpp"
+#include "algebra/symbolic.hpp"
 #include "base/limits.hpp"
 #include "base/number.hpp"
 #include "base/primitive.hpp"
@@ -84,6 +87,152 @@ Value input_like(Value sample) {
   }
   return state_from_leaves(sample, leaves);
 }
+
+namespace {
+
+// ---- kernels: traced as sicm run traces them ------------------------------------------
+//
+// A system derivative (and its Jacobian) is traced as sicm run's
+// trace_procedure traces a kernel (codegen/trace.hpp), so that both modes
+// compute it with the same operations in the same order: its inputs are
+// named x0, x1, ... as sicm run's (the simplifier orders symbols by name),
+// and the numbers and captured run-time values that meet them become
+// parameters k0, k1, ... (KernelParameters, algebra/symbolic.hpp), here
+// variables of the calling function defined just before the call, which
+// the traced function captures as sicm run's kernel reads p[].
+
+// A value shaped like `sample` whose leaves are fresh inputs of the current
+// function named as trace_procedure names a kernel's inputs.
+Value kernel_input_like(Value sample) {
+  gcvec<Value> leaves;
+  state_leaves(sample, leaves);
+  for (Value &leaf : leaves) {
+    leaf = new_var(RType::Real);
+    int id = var_of(leaf);
+    Symbol *named = make_uninterned_symbol("x" + std::to_string(current().inputs.size())).symbol();
+    g_build->var_ids.erase(g_build->program.vars[id].sym);
+    g_build->program.vars[id].sym = named;
+    g_build->var_ids[named] = id;
+    leaf = Value::object(Tag::Symbol, named);
+    current().inputs.push_back(id);
+  }
+  return state_from_leaves(sample, leaves);
+}
+
+// Where the parameters of the kernel being traced are defined: the block the
+// caller was in when the trace began (an index into g_build->blocks, whose
+// entry may be null for the function's body), and what it held then.
+struct ParameterSite {
+  int traced;           // the traced function; its vars and those of functions after it are its own
+  int parent;           // the function that calls it
+  size_t block;         // g_build->blocks.size() before the trace's function opened
+  size_t block_size;    // the statements the caller's block had then
+  std::unordered_set<int> parameters;        // the variables make_parameter made
+  std::unordered_map<ExprId, bool> captured; // memo of is_captured
+};
+ParameterSite *g_site = nullptr;
+
+// Each parameter variable's value, as an expression with the numbers as the
+// decimals they were written as: what the singular factors of a system
+// derivative are computed from, so that they factor and read as the
+// numbers (sicm run's compile_kernel does the same).
+std::unordered_map<ExprId, ExprId> g_parameter_values;
+
+std::vector<RStmt> &caller_block(const ParameterSite &site) {
+  std::vector<RStmt> *b = site.block > 0 ? g_build->blocks[site.block - 1] : nullptr;
+  return b ? *b : g_build->program.functions[site.parent].body;
+}
+
+// Does the expression mention no variable of the traced function?
+bool only_outer_variables(ExprId root, ParameterSite &site) {
+  auto hit = site.captured.find(root);
+  if (hit != site.captured.end()) return hit->second;
+  bool outer = true;
+  const ExprNode &n = expr_node(root);
+  if (n.kind == ExprKind::Symbol) {
+    auto v = g_build->var_ids.find(n.sym);
+    outer = v != g_build->var_ids.end() && g_build->program.vars[v->second].function < site.traced &&
+            !site.parameters.count(v->second);
+  } else if (n.kind == ExprKind::Apply || n.kind == ExprKind::Call) {
+    for (ExprId a : expr_arg_vector(root))
+      if (!(outer = only_outer_variables(a, site))) break;
+  }
+  site.captured[root] = outer;
+  return outer;
+}
+
+bool is_captured(Value v) {
+  return g_site && is_dynamic_scalar(v) && only_outer_variables(expr_of(v, "kernel"), *g_site);
+}
+
+// Parameter `sym` (its value `value`) as a variable of the caller, defined
+// in the caller's block. Done once the trace is over: made during the trace,
+// a variable would be undone by the rollbacks of attempts inside it (a loop
+// tried as a C loop) while the trace's parameters still named it.
+void define_parameter(Symbol *sym, Value value) {
+  ParameterSite &site = *g_site;
+  int id = static_cast<int>(g_build->program.vars.size());
+  g_build->program.vars.push_back(RVar{sym, RType::Real, id, site.parent});
+  g_build->var_ids[sym] = id;
+  site.parameters.insert(id);
+  g_parameter_values[expr_symbol(sym)] =
+      value.is(Tag::Flonum) ? expr_from_number(decimal_rational(value.d)) : expr_of(value, "kernel");
+  RStmt s{RKind::Let};
+  s.loc = here();
+  s.compute = RCompute::Expr;
+  s.args = {expr_of(value, "kernel")};
+  s.var = id;
+  caller_block(site).push_back(std::move(s));
+}
+
+const KernelParameterHooks kParameterHooks = {is_captured, nullptr};
+
+// The site of a kernel trace while it lives; rollback() removes what it
+// defined in the caller's block when the trace is abandoned, as it is when
+// an exception leaves the scope (a retrace, a failed trace: the program's
+// variables are rewound, so their definitions must go too).
+class KernelTraceScope {
+public:
+  KernelTraceScope() : outer_(g_site), exceptions_(std::uncaught_exceptions()) {
+    site_.traced = static_cast<int>(g_build->program.functions.size());
+    site_.parent = g_build->open.back();
+    site_.block = g_build->blocks.size();
+    site_.block_size = caller_block(site_).size();
+    g_site = &site_;
+  }
+  ~KernelTraceScope() {
+    if (std::uncaught_exceptions() > exceptions_) rollback();
+    g_site = outer_;
+  }
+  void rollback() {
+    std::vector<RStmt> &b = caller_block(site_);
+    if (b.size() > site_.block_size) b.erase(b.begin() + static_cast<long>(site_.block_size), b.end());
+  }
+
+private:
+  ParameterSite site_;
+  ParameterSite *outer_;
+  int exceptions_;
+};
+
+// proc applied to x as sicm run's kernels are traced, with parameters,
+// which are then defined in the caller.
+Value apply_kernel_traced(Value proc, gcvec<Value> x) {
+  Value result;
+  gcvec<Symbol *> symbols;
+  gcvec<Value> values;
+  {
+    KernelParameters params(&kParameterHooks);
+    result = apply_traced(proc, std::move(x));
+    symbols = params.symbols;
+    values = params.values;
+  }
+  for (size_t j = 0; j < symbols.size(); ++j)
+    define_parameter(symbols[j], values[j]);
+  return result;
+}
+
+} // namespace
 
 bool is_state_shape(Value v) {
   if (is_number(v) || is_dynamic_scalar(v)) return true;
@@ -373,9 +522,10 @@ std::vector<ExprId> system_outputs(const gcvec<Value> &leaves, const char *who) 
 // the same kernel, so both compute the same numbers). Returns its id.
 int trace_system_function(Value sysder, Value state, const char *who) {
   if (!is_state_shape(state)) wrong_type(state, 1, who);
+  KernelTraceScope parameters;
   FunctionScope scope(procedure_name(sysder));
-  gcvec<Value> x{input_like(state)};
-  Value d = apply_traced(sysder, x); // as sicm run traces its kernels
+  gcvec<Value> x{kernel_input_like(state)};
+  Value d = apply_kernel_traced(sysder, x); // as sicm run traces its kernels
   gcvec<Value> leaves;
   if (!derivative_leaves(d, state, leaves, is_scalar_leaf))
     cannot_compile(here(), std::string("the system derivative passed to ") + who + " returns " +
@@ -437,8 +587,9 @@ void trace_singular_factors(Value state, RStmt &s) {
   std::unordered_map<Symbol *, std::string> names;
   for (size_t i = 0; i < from.size() && i < paths.size(); ++i)
     names[from[i]] = paths[i];
-  SingularFactors factors =
-      singular_factors(g_build->program.functions[s.callee].outputs, [&](Symbol *sym) {
+  SingularFactors factors = singular_factors(
+      with_leaves(g_build->program.functions[s.callee].outputs, g_parameter_values),
+      [&](Symbol *sym) {
         auto it = names.find(sym);
         return it == names.end() ? std::string() : it->second;
       });
@@ -461,11 +612,12 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
   Symbol *d = intern("D").symbol();
   if (!d->bound) return;
   size_t nfunctions = g_build->program.functions.size(), nvars = g_build->program.vars.size();
+  KernelTraceScope parameters;
   try {
     FunctionScope scope("jacobian");
     Value dsys = apply_procedure(d->global, &sysder, 1);
-    gcvec<Value> x{input_like(state)};
-    Value j = apply_traced(dsys, x);
+    gcvec<Value> x{kernel_input_like(state)};
+    Value j = apply_kernel_traced(dsys, x);
     gcvec<Value> leaves;
     state_leaves(j, leaves);
     size_t n = current().inputs.size();
@@ -474,6 +626,7 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
     current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
     s.jacobian = scope.id();
   } catch (const Error &) {
+    parameters.rollback();
     for (size_t v = nvars; v < g_build->program.vars.size(); ++v)
       g_build->var_ids.erase(g_build->program.vars[v].sym);
     g_build->program.functions.resize(nfunctions);

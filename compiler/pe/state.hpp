@@ -177,6 +177,8 @@ Value with_retrace(const std::function<Value()> &body);
 // current function), and going back there to abandon a trace.
 struct ProgramMark {
   size_t nfunctions, nvars, nbody;
+  std::vector<RStmt> *block; // the current block when it is not the body, or null
+  size_t nblock;             // its statements then
 };
 ProgramMark mark_program();
 void rewind_program(const ProgramMark &mark);

@@ -396,7 +396,9 @@ typedef struct {
 } block;
 
 static void block_put(block *b, const void *data, size_t len) {
-  if (b->failed) return;
+  /* Nothing to add: data may be NULL then (an empty list's items), and
+   * memcpy from NULL is undefined even for 0 bytes. */
+  if (b->failed || len == 0) return;
   if (!grow(&b->bytes, b->len, &b->cap, len)) {
     b->failed = 1;
     return;
