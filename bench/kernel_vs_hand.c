@@ -4,6 +4,9 @@
  *   -DDIM=n                 the number of state leaves (t first)
  *   -DGEN_KERNEL=name       the kernel `sicm emit-c` printed, renamed by the driver
  *   -DHAND_KERNEL=name      the hand-written version (bench/kernels/hand_*.c)
+ *   -DGEN_PARAMS={...}      the p[] the generated kernel takes (its captured numbers, which
+ *                           `sicm emit-kernels` prints above it; the hand-written one has
+ *                           its numbers as constants and is given no p[])
  * Both are compiled as separate translation units with the same flags as this file, so
  * neither is inlined here and both are called as the runtime calls a kernel: through the
  * ABI void f(const double *in, double *out, const double *p).
@@ -27,6 +30,7 @@
 
 typedef void kernel_fn(const double *in, double *out, const double *p);
 kernel_fn GEN_KERNEL, HAND_KERNEL;
+static const double gen_params[] = GEN_PARAMS;
 
 enum { kChecks = 1000, kMaxRounds = 101 };
 static const double kAgreement = 1e-12;
@@ -55,7 +59,7 @@ static double max_difference(void) {
     in[0] = uniform(&seed, 0, 100);
     for (int i = 1; i < DIM; i++)
       in[i] = uniform(&seed, -3, 3);
-    GEN_KERNEL(in, g, NULL);
+    GEN_KERNEL(in, g, gen_params);
     HAND_KERNEL(in, h, NULL);
     for (int i = 0; i < DIM; i++) {
       double d = fabs(g[i] - h[i]) / fmax(1.0, fabs(h[i]));
@@ -66,12 +70,12 @@ static double max_difference(void) {
 }
 
 /* Nanoseconds per call of f over n calls from y0; the final state goes to sink. */
-static double time_calls(kernel_fn *f, long n, const double *y0, double *sink) {
+static double time_calls(kernel_fn *f, const double *p, long n, const double *y0, double *sink) {
   double y[DIM], dy[DIM];
   memcpy(y, y0, sizeof y);
   double start = now();
   for (long k = 0; k < n; k++) {
-    f(y, dy, NULL);
+    f(y, dy, p);
     for (int i = 0; i < DIM; i++)
       y[i] += kStep * dy[i];
   }
@@ -114,15 +118,15 @@ int main(int argc, char **argv) {
   }
 
   double sink = 0, gen[kMaxRounds], hand[kMaxRounds], ratio[kMaxRounds];
-  time_calls(GEN_KERNEL, n / 10 + 1, y0, &sink); /* warm-up: caches, branch predictors, clock */
-  time_calls(HAND_KERNEL, n / 10 + 1, y0, &sink);
+  time_calls(GEN_KERNEL, gen_params, n / 10 + 1, y0, &sink); /* warm-up: caches, branch predictors, clock */
+  time_calls(HAND_KERNEL, NULL, n / 10 + 1, y0, &sink);
   for (int r = 0; r < rounds; r++) {
     if (r % 2 == 0) {
-      gen[r] = time_calls(GEN_KERNEL, n, y0, &sink);
-      hand[r] = time_calls(HAND_KERNEL, n, y0, &sink);
+      gen[r] = time_calls(GEN_KERNEL, gen_params, n, y0, &sink);
+      hand[r] = time_calls(HAND_KERNEL, NULL, n, y0, &sink);
     } else {
-      hand[r] = time_calls(HAND_KERNEL, n, y0, &sink);
-      gen[r] = time_calls(GEN_KERNEL, n, y0, &sink);
+      hand[r] = time_calls(HAND_KERNEL, NULL, n, y0, &sink);
+      gen[r] = time_calls(GEN_KERNEL, gen_params, n, y0, &sink);
     }
     ratio[r] = gen[r] / hand[r];
   }

@@ -61,8 +61,6 @@ ExprId value_to_expr(Value v, int argpos, const char *who) {
 
 thread_local int g_decimal_constants = 0;
 
-
-
 // ---- kernel parameters (see KernelParameters) --------------------------------------
 
 thread_local KernelParameters *g_kernel_parameters = nullptr;
@@ -79,8 +77,7 @@ bool parametric_flonum(Value v) {
 }
 
 bool captured_run_time_value(Value v) {
-  const KernelParameterHooks *hooks = g_kernel_parameters->hooks();
-  return hooks && !is_number(v) && hooks->is_captured(v);
+  return !is_number(v) && g_kernel_parameters->is_captured(v);
 }
 
 // Does v depend on the kernel's inputs (a symbolic value that is not a
@@ -253,8 +250,8 @@ DecimalConstants::~DecimalConstants() {
   --g_decimal_constants;
 }
 
-KernelParameters::KernelParameters(const KernelParameterHooks *hooks)
-    : hooks_(hooks), outer_(g_kernel_parameters) {
+KernelParameters::KernelParameters(CapturedTest is_captured)
+    : is_captured_(is_captured), outer_(g_kernel_parameters) {
   g_kernel_parameters = this;
 }
 
@@ -264,16 +261,16 @@ KernelParameters::~KernelParameters() {
 
 Value KernelParameters::parameter_for(Value v) {
   // Equal flonums are one parameter; a run-time value is one by its expression.
-  for (size_t j = 0; j < values.size(); ++j) {
-    Value w = values[j];
-    if (v.is(Tag::Flonum) ? w.is(Tag::Flonum) && std::memcmp(&w.d, &v.d, sizeof v.d) == 0
-                          : !w.is(Tag::Flonum) && value_to_expr(w, 1, "kernel") ==
-                                                      value_to_expr(v, 1, "kernel"))
-      return Value::object(Tag::Symbol, symbols[j]);
+  size_t next = values.size(), j;
+  if (v.is(Tag::Flonum)) {
+    uint64_t bits;
+    std::memcpy(&bits, &v.d, sizeof bits);
+    j = by_bits_.emplace(bits, next).first->second;
+  } else {
+    j = by_expression_.emplace(value_to_expr(v, 1, "kernel"), next).first->second;
   }
-  size_t index = values.size();
-  Value sym = hooks_ && hooks_->make ? hooks_->make(v, index)
-                     : make_uninterned_symbol("k" + std::to_string(index));
+  if (j < next) return Value::object(Tag::Symbol, symbols[j]);
+  Value sym = make_uninterned_symbol("k" + std::to_string(values.size()));
   values.push_back(v);
   symbols.push_back(sym.symbol());
   return sym;

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <unordered_map>
 
 #include "base/value.hpp"
 #include "cas/ops.hpp"
@@ -56,10 +57,6 @@ Value expression_to_datum(Value v);
 // kernel's numbers are rounded to doubles once, at emission, so a constant
 // the user wrote reads back as exactly the double it was. Arithmetic on
 // numbers alone is untouched: (* 1.5 9.8) is still a flonum product.
-// The exact rational of the shortest decimal that reads back as the finite
-// flonum d (9.8 -> 49/5), as DecimalConstants makes it.
-Value decimal_rational(double d);
-
 class DecimalConstants {
 public:
   DecimalConstants();
@@ -67,6 +64,10 @@ public:
   DecimalConstants(const DecimalConstants &) = delete;
   DecimalConstants &operator=(const DecimalConstants &) = delete;
 };
+
+// The exact rational of the shortest decimal that reads back as the finite
+// flonum d (9.8 -> 49/5), as DecimalConstants makes it.
+Value decimal_rational(double d);
 
 // While a KernelParameters lives (on this thread, inside a trace: see
 // codegen/trace.hpp), a number the traced procedure brings into an operation
@@ -81,22 +82,16 @@ public:
 // switched off costs nothing, a unit mass divides nothing) and exponents.
 // Equal flonums are one parameter.
 //
-// sicm build gives hooks (KernelParameterHooks), so that a value known only
-// at run time that the procedure captured (a (parameter), a result of an
+// Parameter j is the uninterned symbol k<j>. sicm build says which values
+// are captured run-time values (is_captured: a symbol or an expression that
+// does not depend on the kernel's inputs), so that a value known only at
+// run time that the procedure captured (a (parameter), a result of an
 // earlier integration) is a parameter in the same way: the trace of a
 // system derivative is then the same in both modes, and so is its C.
-struct KernelParameterHooks {
-  // Is v a captured run-time value (a symbol or an expression that does not
-  // depend on the kernel's inputs)?
-  bool (*is_captured)(Value v);
-  // The symbol that stands for parameter `index`, whose value is `value`
-  // (null: an uninterned symbol named k<index>, as without hooks).
-  Value (*make)(Value value, size_t index);
-};
-
 class KernelParameters {
 public:
-  explicit KernelParameters(const KernelParameterHooks *hooks = nullptr);
+  using CapturedTest = bool (*)(Value v);
+  explicit KernelParameters(CapturedTest is_captured = nullptr);
   ~KernelParameters();
   KernelParameters(const KernelParameters &) = delete;
   KernelParameters &operator=(const KernelParameters &) = delete;
@@ -106,13 +101,18 @@ public:
   gcvec<Symbol *> symbols;
   gcvec<Value> values;
 
-  // The parameter standing for v (made on first use); for symbolic.cpp.
+  // For symbolic.cpp: the parameter standing for v (made on first use), and
+  // whether v is a captured run-time value.
   Value parameter_for(Value v);
-  const KernelParameterHooks *hooks() const { return hooks_; }
+  bool is_captured(Value v) const { return is_captured_ && is_captured_(v); }
 
 private:
-  const KernelParameterHooks *hooks_;
+  CapturedTest is_captured_;
   KernelParameters *outer_;
+  // Parameter of each value met: flonums by their bits, run-time values by
+  // their expression.
+  std::unordered_map<uint64_t, size_t> by_bits_;
+  std::unordered_map<uint32_t, size_t> by_expression_;
 };
 
 // Register the algebra's primitives (simplify, print-expression, pe,

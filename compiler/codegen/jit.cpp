@@ -488,6 +488,8 @@ void *loaded_handle(const std::string &so) {
   return h == g_handles.end() ? nullptr : h->second;
 }
 
+thread_local SrcLoc g_request_site; // see JitRequest
+
 // Is there room for one more shared object under --max-compiled-kernels?
 // When there is not, the first refusal says so on stderr, at the user's line.
 bool may_load_another(std::string *why_not) {
@@ -502,12 +504,14 @@ bool may_load_another(std::string *why_not) {
              " distinct procedures (--max-compiled-kernels)";
   static std::atomic<bool> told{false};
   if (!told.exchange(true)) {
-    SrcLoc loc = current_call_loc().known() ? current_call_loc() : current_toplevel_loc();
+    SrcLoc loc = g_request_site.known()     ? g_request_site
+                 : current_call_loc().known() ? current_call_loc()
+                                              : current_toplevel_loc();
     std::fprintf(stderr,
-                 "%s: note: %zu procedures that differ in structure have been compiled, the "
-                 "limit (--max-compiled-kernels=%llu); procedures not compiled yet are "
+                 "%s: note: the limit on compiled procedures that differ in structure "
+                 "(--max-compiled-kernels=%llu) is reached; procedures not compiled yet are "
                  "interpreted from here on, more slowly\n",
-                 loc_text(loc).c_str(), loaded, static_cast<unsigned long long>(limit));
+                 loc_text(loc).c_str(), static_cast<unsigned long long>(limit));
   }
   return false;
 }
@@ -572,6 +576,14 @@ std::string jit_cache_dir() {
                    dir.c_str(), unsafe.c_str());
   }
   return fallback_dir();
+}
+
+JitRequest::JitRequest(SrcLoc where) : saved_(g_request_site) {
+  g_request_site = where;
+}
+
+JitRequest::~JitRequest() {
+  g_request_site = saved_;
 }
 
 void *jit_load(const std::string &c_source, const std::string &symbol, std::string *so_path,

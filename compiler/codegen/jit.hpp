@@ -25,7 +25,24 @@
 #include <string_view>
 #include <vector>
 
+#include "base/srcloc.hpp"
+
 namespace sicm {
+
+// While a JitRequest lives (on this thread), a shared object that
+// --max-compiled-kernels refuses is reported at `where`: the user's line
+// that asked for the compiled procedure, taken before tracing it moves the
+// evaluator into the procedure (or the library).
+class JitRequest {
+public:
+  explicit JitRequest(SrcLoc where);
+  ~JitRequest();
+  JitRequest(const JitRequest &) = delete;
+  JitRequest &operator=(const JitRequest &) = delete;
+
+private:
+  SrcLoc saved_;
+};
 
 // Compile (or find in the cache) `c_source`, load it and return the address
 // of `symbol` in it. On failure returns null and a one-line reason (with the

@@ -263,6 +263,7 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   std::string ignored;
   if (!why_not) why_not = &ignored;
   std::string kname = name ? name : procedure_name(proc);
+  JitRequest request(user_call_loc()); // before the trace moves the evaluator into proc
   Trace t;
   if (!trace_procedure(proc, sample_args, &t, why_not)) return nullptr;
   std::string c_name = c_kernel_name(kname);

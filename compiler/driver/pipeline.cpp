@@ -48,6 +48,7 @@
 #include "builtins/effects_used.hpp"
 #include "builtins/parameter.hpp"
 #include "builtins/plot.hpp"
+#include "codegen/emit_c.hpp"
 #include "codegen/kernel.hpp"
 #include "codegen/kernel_report.hpp"
 #include "codegen/residual_dump.hpp"
@@ -91,7 +92,14 @@ std::string g_emitted;
 
 void collect_kernel(const Kernel *k) {
   if (g_emitted.find(k->c_source) != std::string::npos) return; // the same kernel again
-  g_emitted += "/* ---- kernel " + k->c_name + " ---- */\n" + k->c_source + "\n";
+  g_emitted += "/* ---- kernel " + k->c_name + " ---- */\n";
+  if (!k->params.empty()) { // the values its p[] holds here (codegen/kernel.hpp)
+    g_emitted += "/* p[] = {";
+    for (size_t j = 0; j < k->params.size(); ++j)
+      g_emitted += (j ? ", " : "") + c_double_literal(k->params[j]);
+    g_emitted += "} */\n";
+  }
+  g_emitted += k->c_source + "\n";
 }
 
 // --param and --fix must name parameters the program declared: a

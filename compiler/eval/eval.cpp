@@ -164,6 +164,11 @@ bool is_library_loc(SrcLoc loc) {
   return loc.known() && loc.file < g_first_user_file;
 }
 
+SrcLoc user_call_loc() {
+  SrcLoc call = current_call_loc();
+  return call.known() && !is_library_loc(call) ? call : current_toplevel_loc();
+}
+
 void register_apply_primitive(Value apply) {
   g_apply_primitive = apply.p;
 }

@@ -73,6 +73,9 @@ Value apply_procedure(Value proc, Value *args, int nargs);
 // forms was running.
 void set_first_user_file(uint32_t file);
 bool is_library_loc(SrcLoc loc);
+// The user's line that is running: the current call when it is the user's,
+// else the user's top-level form (a call inside the library).
+SrcLoc user_call_loc();
 
 // Tell the evaluator which primitive is `apply`, so calls to it are tail calls.
 void register_apply_primitive(Value apply);

@@ -174,9 +174,10 @@ RType expr_type(ExprId id) {
 
 } // namespace
 
-Value new_var(RType type) {
+Value new_var(RType type, const std::string &name) {
   int id = static_cast<int>(g_build->program.vars.size());
-  Value sym = make_uninterned_symbol(kMarkerPrefix + std::to_string(id) + kMarkerSuffix);
+  Value sym = make_uninterned_symbol(
+      name.empty() ? kMarkerPrefix + std::to_string(id) + kMarkerSuffix : name);
   g_build->program.vars.push_back(RVar{sym.symbol(), type, id, g_build->open.back()});
   g_build->var_ids[sym.symbol()] = id;
   return sym;
@@ -379,7 +380,9 @@ namespace {
 
 // A run-time scalar as a variable (an expression gets a Let).
 Value as_var(Value v) {
-  if (var_of(v) >= 0) return v;
+  // A variable printed as itself is written as its marker: a kernel input
+  // (named x0 ...) is copied into a variable that has one.
+  if (var_of(v) >= 0 && symbol_name(v).rfind(kMarkerPrefix, 0) == 0) return v;
   return let(RCompute::Expr, {expr_of(v, "printing")}, scalar_type(v)); // a sum of counts is one
 }
 

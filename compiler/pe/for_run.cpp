@@ -173,6 +173,7 @@ CompiledFn compile_traced_for_run(Value proc, const std::function<int()> &trace,
     *why_not = "--max-steps counts the interpreter's steps";
     return nullptr;
   }
+  JitRequest request(user_call_loc()); // where --max-compiled-kernels would say so
   ResidualProgram program;
   int id = -1;
   {

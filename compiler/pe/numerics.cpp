@@ -107,14 +107,8 @@ Value kernel_input_like(Value sample) {
   gcvec<Value> leaves;
   state_leaves(sample, leaves);
   for (Value &leaf : leaves) {
-    leaf = new_var(RType::Real);
-    int id = var_of(leaf);
-    Symbol *named = make_uninterned_symbol("x" + std::to_string(current().inputs.size())).symbol();
-    g_build->var_ids.erase(g_build->program.vars[id].sym);
-    g_build->program.vars[id].sym = named;
-    g_build->var_ids[named] = id;
-    leaf = Value::object(Tag::Symbol, named);
-    current().inputs.push_back(id);
+    leaf = new_var(RType::Real, "x" + std::to_string(current().inputs.size()));
+    current().inputs.push_back(var_of(leaf));
   }
   return state_from_leaves(sample, leaves);
 }
@@ -127,16 +121,10 @@ struct ParameterSite {
   int parent;           // the function that calls it
   size_t block;         // g_build->blocks.size() before the trace's function opened
   size_t block_size;    // the statements the caller's block had then
-  std::unordered_set<int> parameters;        // the variables make_parameter made
+  std::unordered_set<int> parameters;        // the variables define_parameter made
   std::unordered_map<ExprId, bool> captured; // memo of is_captured
 };
 ParameterSite *g_site = nullptr;
-
-// Each parameter variable's value, as an expression with the numbers as the
-// decimals they were written as: what the singular factors of a system
-// derivative are computed from, so that they factor and read as the
-// numbers (sicm run's compile_kernel does the same).
-std::unordered_map<ExprId, ExprId> g_parameter_values;
 
 std::vector<RStmt> &caller_block(const ParameterSite &site) {
   std::vector<RStmt> *b = site.block > 0 ? g_build->blocks[site.block - 1] : nullptr;
@@ -175,7 +163,7 @@ void define_parameter(Symbol *sym, Value value) {
   g_build->program.vars.push_back(RVar{sym, RType::Real, id, site.parent});
   g_build->var_ids[sym] = id;
   site.parameters.insert(id);
-  g_parameter_values[expr_symbol(sym)] =
+  g_build->parameter_values[expr_symbol(sym)] =
       value.is(Tag::Flonum) ? expr_from_number(decimal_rational(value.d)) : expr_of(value, "kernel");
   RStmt s{RKind::Let};
   s.loc = here();
@@ -184,8 +172,6 @@ void define_parameter(Symbol *sym, Value value) {
   s.var = id;
   caller_block(site).push_back(std::move(s));
 }
-
-const KernelParameterHooks kParameterHooks = {is_captured, nullptr};
 
 // The site of a kernel trace while it lives; rollback() removes what it
 // defined in the caller's block when the trace is abandoned, as it is when
@@ -222,7 +208,7 @@ Value apply_kernel_traced(Value proc, gcvec<Value> x) {
   gcvec<Symbol *> symbols;
   gcvec<Value> values;
   {
-    KernelParameters params(&kParameterHooks);
+    KernelParameters params(is_captured);
     result = apply_traced(proc, std::move(x));
     symbols = params.symbols;
     values = params.values;
@@ -588,7 +574,7 @@ void trace_singular_factors(Value state, RStmt &s) {
   for (size_t i = 0; i < from.size() && i < paths.size(); ++i)
     names[from[i]] = paths[i];
   SingularFactors factors = singular_factors(
-      with_leaves(g_build->program.functions[s.callee].outputs, g_parameter_values),
+      with_leaves(g_build->program.functions[s.callee].outputs, g_build->parameter_values),
       [&](Symbol *sym) {
         auto it = names.find(sym);
         return it == names.end() ? std::string() : it->second;

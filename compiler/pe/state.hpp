@@ -81,7 +81,12 @@ struct BuildState {
   gcvec<Value> rebound_values; // scanned: the primitives' objects stay alive
   std::vector<bool> rebound_bound;
 
-  // ---- pe/numerics.cpp: what the procedures state-advancer and evolve return print as
+  // ---- pe/numerics.cpp: each kernel parameter variable's value, as an
+  // expression with the numbers as the decimals they were written as: what
+  // the singular factors of a system derivative are computed from, so that
+  // they factor and read as the numbers (as sicm run's compile_kernel does)
+  std::unordered_map<ExprId, ExprId> parameter_values;
+  // what the procedures state-advancer and evolve return print as
   Lambda advancer_lambda, evolver_lambda;
 
   // ---- pe/branches.cpp
@@ -136,8 +141,10 @@ RFunction &current();
 // Where statements go now: the innermost alternative's block or open function's body.
 std::vector<RStmt> &current_block();
 
-// A fresh run-time value (a marker symbol) for a new variable of the current function.
-Value new_var(RType type);
+// A fresh run-time value (a marker symbol) for a new variable of the current
+// function; named `name` instead of a marker for a kernel's inputs, which
+// are named as sicm run names them (pe/numerics.cpp).
+Value new_var(RType type, const std::string &name = "");
 // The residual variable v stands for, or -1.
 int var_of(Value v);
 // v as a run-time list, or null.

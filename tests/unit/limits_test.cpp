@@ -400,6 +400,50 @@ TEST(LimitsBuild, ResidualSizeLimitIsACompileError) {
       << err;
 }
 
+// --max-compiled-kernels counts kernels that differ in structure: systems
+// that differ only in their numbers are one kernel (their numbers are its
+// parameters), so a scan of springs stays under a bound of 1 without a
+// note; a system of another structure past the bound is interpreted, with
+// one note on stderr at the user's line. Each program checks its results
+// itself (an error exits 70).
+const char kSprings[] =
+    "(define ((L-spring m k) local)\n"
+    "  (- (* 1/2 m (square (velocity local))) (* 1/2 k (square (coordinate local)))))\n"
+    "(define (x k) (coordinate ((state-advancer Lagrangian->state-derivative\n"
+    "                            (L-spring 1.5 k)) (up 0. 1. 0.) 1. 1e-12)))\n"
+    "(for-each (lambda (k) (if (> (abs (- (x k) (cos (sqrt (/ k 1.5))))) 1e-9)\n"
+    "                          (error \"wrong x(1) for k =\" k)))\n"
+    "          '(.3 .7 1.1 2.3 3.7))\n";
+
+TEST(LimitsRun, SystemsThatDifferInValueStayUnderABoundOfOneKernel) {
+  if (!have_sicm()) GTEST_SKIP() << "no sicm binary at " << sicm_binary();
+  std::string prog = write_program(temp_dir(), kSprings);
+  std::string err;
+  EXPECT_EQ(run_sicm({"run", "--max-compiled-kernels=1", prog}, &err), 0) << err;
+  EXPECT_EQ(err, "");
+}
+
+TEST(LimitsRun, PastTheKernelBoundANoteSaysSoOnceAtTheUsersLine) {
+  if (!have_sicm()) GTEST_SKIP() << "no sicm binary at " << sicm_binary();
+  std::string prog = write_program(
+      temp_dir(), std::string(kSprings) +
+                      "(define ((L-pend l g) local)\n"
+                      "  (+ (* 1/2 (square (* l (velocity local)))) (* g l (cos (coordinate "
+                      "local)))))\n"
+                      "(define (th l) (coordinate ((state-advancer Lagrangian->state-derivative\n"
+                      "                             (L-pend l 9.8)) (up 0. 1. 0.) 1. 1e-12)))\n"
+                      "(for-each (lambda (l) (if (> (abs (th l)) 1) (error \"wrong\" l)))\n"
+                      "          '(.7 .9))\n");
+  std::string err;
+  EXPECT_EQ(run_sicm({"run", "--max-compiled-kernels=1", prog}, &err), 0) << err;
+  EXPECT_NE(err.find("program.sicm:10:"), std::string::npos) << err; // th's call
+  EXPECT_NE(err.find("note: the limit on compiled procedures that differ in structure "
+                     "(--max-compiled-kernels=1) is reached"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(err.find("note:"), err.rfind("note:")) << "said once: " << err;
+}
+
 TEST(LimitsRun, BadFlagIsAUsageError) {
   if (!have_sicm()) GTEST_SKIP() << "no sicm binary at " << sicm_binary();
   std::string prog = write_program(temp_dir(), "(display 1)\n");
