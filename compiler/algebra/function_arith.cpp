@@ -115,12 +115,19 @@ Value make_native_procedure(NativeFn fn, int op, Value a, Value b, const Value *
 }
 
 void native_arity_error(NativeProc *self, int given, int required) {
+  native_arity_error(self, given, required, required);
+}
+
+void native_arity_error(NativeProc *self, int given, int min, int max) {
   auto plural = [](int n) { return std::to_string(n) + (n == 1 ? " argument" : " arguments"); };
   std::string name;
   write_native(name, self, false);
-  runtime_error(current_call_loc(), "The procedure " + name + " has been called with " +
-                                        plural(given) + "; it requires exactly " +
-                                        plural(required) + ".");
+  runtime_error(current_call_loc(),
+                "The procedure " + name + " has been called with " + plural(given) +
+                    "; it requires " +
+                    (min == max ? "exactly " + plural(min)
+                                : "between " + std::to_string(min) + " and " + plural(max)) +
+                    ".");
 }
 
 Value compose_procedures(const Value *fs, size_t n) {

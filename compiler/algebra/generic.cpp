@@ -409,8 +409,9 @@ void install_generic_primitives() {
   register_symbolic_arith();
   register_structure_arith();
   register_function_arith();
+  // Generic arithmetic: every row computes from its arguments alone.
   for (const GenericSpec &p : kGenericPrimitives)
-    define_primitive(p.name, p.min_args, p.max_args, p.fn);
+    define_primitive(p.name, p.min_args, p.max_args, Stage::Pure, p.fn);
   install_structure_primitives();
 }
 

@@ -140,6 +140,8 @@ Value make_native_procedure(NativeFn fn, int op, Value a, Value b, const Value *
                             size_t nitems = 0);
 // MIT's arity error for a NativeProc that takes exactly `required` arguments.
 [[noreturn]] void native_arity_error(NativeProc *self, int given, int required);
+// ... "it requires between 4 and 6 arguments." (exactly, when min == max).
+[[noreturn]] void native_arity_error(NativeProc *self, int given, int min, int max);
 // (compose f g ...): the procedure x... |-> (f (g ... x...)).
 Value compose_procedures(const Value *fs, size_t n);
 

@@ -189,8 +189,8 @@ Value make_literal_function(Value name, Value type) {
 }
 
 void install_literal_function_primitives() {
-  define_primitive("literal-function", 1, 2, P_literal_function);
-  define_primitive("literal-function?", 1, 1, P_literal_function_p);
+  define_primitive("literal-function", 1, 2, Stage::Pure, P_literal_function);
+  define_primitive("literal-function?", 1, 1, Stage::Pure, P_literal_function_p);
 }
 
 } // namespace sicm

@@ -345,14 +345,14 @@ Value apply_operator(Value opv, Value f) {
 void install_operator_primitives() {
   register_arith_type(&kOperatorArith);
   define_global("D", make_derivative({}));
-  define_primitive("partial", 1, kVariadic, P_partial);
+  define_primitive("partial", 1, kVariadic, Stage::Pure, P_partial);
   // scmutils's procedure form of D, made an operator as well, so that
   // operator arithmetic applies: (square derivative) is the second derivative.
   Value derivative = make_derivative({});
   as_operator(derivative)->name = intern("derivative");
   define_global("derivative", derivative);
-  define_primitive("operator?", 1, 1, P_operator_p);
-  define_primitive("make-operator", 1, 2, P_make_operator);
+  define_primitive("operator?", 1, 1, Stage::Pure, P_operator_p);
+  define_primitive("make-operator", 1, 2, Stage::Pure, P_make_operator);
   define_global("I", identity_operator());
 }
 

@@ -342,12 +342,12 @@ Value make_exp_series(Value op, Value f) {
 
 void install_series_primitives() {
   register_arith_type(&kSeriesArith);
-  define_primitive("series:for-each", 3, 3, P_series_for_each);
-  define_primitive("series:print", 2, 2, P_series_print);
-  define_primitive("series:ref", 2, 2, P_series_ref);
-  define_primitive("series:sum", 2, 2, P_series_sum);
-  define_primitive("series", 0, kVariadic, P_series);
-  define_primitive("series?", 1, 1, P_series_p);
+  define_primitive("series:for-each", 3, 3, Stage::Effect, P_series_for_each);
+  define_primitive("series:print", 2, 2, Stage::Effect, P_series_print);
+  define_primitive("series:ref", 2, 2, Stage::Pure, P_series_ref);
+  define_primitive("series:sum", 2, 2, Stage::Pure, P_series_sum);
+  define_primitive("series", 0, kVariadic, Stage::Pure, P_series);
+  define_primitive("series?", 1, 1, Stage::Pure, P_series_p);
 }
 
 } // namespace sicm

@@ -498,8 +498,9 @@ const StructureSpec kStructurePrimitives[] = {
 void install_structure_primitives() {
   set_datum_converter(Tag::Structure, structure_to_datum);
   set_datum_converter(Tag::Matrix, matrix_to_datum);
+  // Structures and matrices: every row computes from its arguments alone.
   for (const StructureSpec &p : kStructurePrimitives)
-    define_primitive(p.name, p.min_args, p.max_args, p.fn);
+    define_primitive(p.name, p.min_args, p.max_args, Stage::Pure, p.fn);
 }
 
 } // namespace sicm

@@ -422,11 +422,11 @@ Value P_datum_to_expression(Value *a, int) {
 } // namespace
 
 void install_algebra_primitives() {
-  define_primitive("simplify", 1, 1, P_simplify);
-  define_primitive("print-expression", 1, 1, P_print_expression);
-  define_primitive("pe", 1, 1, P_print_expression);
-  define_primitive("expression", 1, 1, P_expression);
-  define_primitive("datum->expression", 1, 1, P_datum_to_expression);
+  define_primitive("simplify", 1, 1, Stage::Pure, P_simplify);
+  define_primitive("print-expression", 1, 1, Stage::Effect, P_print_expression);
+  define_primitive("pe", 1, 1, Stage::Effect, P_print_expression);
+  define_primitive("expression", 1, 1, Stage::Pure, P_expression);
+  define_primitive("datum->expression", 1, 1, Stage::Pure, P_datum_to_expression);
   set_datum_converter(Tag::Expr, expression_to_datum);
 }
 

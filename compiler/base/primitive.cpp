@@ -7,9 +7,22 @@ namespace sicm {
 
 // ---- registration and argument errors --------------------------------------
 
-void define_primitive(const char *name, int min_args, int max_args, PrimFn fn) {
-  Primitive *p = gc_new<Primitive>(Primitive{name, min_args, max_args, fn});
-  define_global(name, Value::object(Tag::Primitive, p));
+namespace {
+gcvec<Value> g_defined; // static, hence a root for the collector
+} // namespace
+
+void define_primitive(const char *name, int min_args, int max_args, Stage stage, PrimFn fn) {
+  Primitive *p = gc_new<Primitive>(Primitive{name, min_args, max_args, fn, stage});
+  Value v = Value::object(Tag::Primitive, p);
+  g_defined.push_back(v);
+  define_global(name, v);
+}
+
+std::vector<const Primitive *> defined_primitives() {
+  std::vector<const Primitive *> all;
+  for (Value v : g_defined)
+    all.push_back(v.as<Primitive>());
+  return all;
 }
 
 void define_global(const char *name, Value v) {
@@ -63,6 +76,13 @@ void bad_range(Value obj, int argpos, const char *who) {
   runtime_error(current_call_loc(), "The object " + written(obj) + ", passed as the " +
                                         ordinal(argpos) + " argument to " + who +
                                         ", is not in the correct range.");
+}
+
+void bad_range(Value obj, int argpos, const char *who, const std::string &rule) {
+  refuse_run_time_argument(obj, argpos, who);
+  runtime_error(current_call_loc(), "The object " + written(obj) + ", passed as the " +
+                                        ordinal(argpos) + " argument to " + who +
+                                        ", is not in the correct range (" + rule + ").");
 }
 
 int64_t arg_fixnum(Value *args, int i, const char *who) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "base/value.hpp"
 
@@ -11,17 +12,31 @@ namespace sicm {
 // A primitive receives its evaluated arguments in a contiguous array.
 using PrimFn = Value (*)(Value *args, int nargs);
 
+// When a primitive's work happens, declared where it is defined (the
+// argument of define_primitive has no default, so a new primitive cannot
+// silently be computed while compiling): sicm build computes a Pure one
+// while compiling whenever its arguments are known; an Effect (output,
+// clocks, randomness, mutation, plots, errors) and RunTime work (the
+// numerical primitives, parameters, parallel maps) the build must handle
+// itself, which tests/unit/primitive_stage_test.cpp checks against the
+// build's tables (pe/specialized.hpp).
+enum class Stage { Pure, Effect, RunTime };
+
 struct Primitive {
   const char *name;
   int min_args;
   int max_args; // -1: any number
   PrimFn fn;
+  Stage stage;
 };
 
 constexpr int kVariadic = -1;
 
 // Bind `name` in the global environment to a new primitive.
-void define_primitive(const char *name, int min_args, int max_args, PrimFn fn);
+void define_primitive(const char *name, int min_args, int max_args, Stage stage, PrimFn fn);
+
+// Every primitive defined so far, in order (rebinding adds another).
+std::vector<const Primitive *> defined_primitives();
 // Bind `name` to an existing value (constants such as pi, aliases).
 void define_global(const char *name, Value v);
 
@@ -38,6 +53,9 @@ RunTimeValueTest run_time_value_test(); // null outside sicm build
 [[noreturn]] void wrong_type(Value obj, int argpos, const char *who);
 //   "The object 10, passed as the second argument to vector-ref, is not in the correct range."
 [[noreturn]] void bad_range(Value obj, int argpos, const char *who);
+//   the same with the rule the object breaks: "..., is not in the correct
+//   range (a tolerance is a positive real)."
+[[noreturn]] void bad_range(Value obj, int argpos, const char *who, const std::string &rule);
 
 // Argument checkers that return the unwrapped value or raise wrong_type.
 int64_t arg_fixnum(Value *args, int i, const char *who); // exact integer in int64 range

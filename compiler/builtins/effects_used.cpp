@@ -31,7 +31,7 @@ const std::vector<std::string> &used_effects() {
 }
 
 void install_effect_primitives() {
-  define_primitive("%use-effect", 1, 1, P_use_effect);
+  define_primitive("%use-effect", 1, 1, Stage::Effect, P_use_effect);
 }
 
 } // namespace sicm

@@ -109,9 +109,9 @@ Value P_kernel_c_source(Value *a, int) {
 } // namespace
 
 void install_kernel_primitives() {
-  define_primitive("compile-procedure", 1, kVariadic, P_compile_procedure);
-  define_primitive("kernel?", 1, 1, P_kernel_p);
-  define_primitive("kernel-c-source", 1, 1, P_kernel_c_source);
+  define_primitive("compile-procedure", 1, kVariadic, Stage::Pure, P_compile_procedure);
+  define_primitive("kernel?", 1, 1, Stage::Pure, P_kernel_p);
+  define_primitive("kernel-c-source", 1, 1, Stage::Pure, P_kernel_c_source);
 }
 
 } // namespace sicm

@@ -306,6 +306,7 @@ struct PrimitiveSpec {
   const char *name;
   int min_args, max_args;
   PrimFn fn;
+  Stage stage = Stage::Pure; // arithmetic; the one exception says so in its row
 };
 
 const PrimitiveSpec kArithmetic[] = {
@@ -394,12 +395,12 @@ const PrimitiveSpec kFunctions[] = {
     {"conjugate", 1, 1, unary<num_conjugate>},
     {"number->string", 1, 2, prim_number_to_string},
     {"string->number", 1, 2, prim_string_to_number},
-    {"random", 1, 2, prim_random},
+    {"random", 1, 2, prim_random, Stage::Effect},
 };
 
 template <size_t N> void install(const PrimitiveSpec (&specs)[N]) {
   for (const auto &s : specs)
-    define_primitive(s.name, s.min_args, s.max_args, s.fn);
+    define_primitive(s.name, s.min_args, s.max_args, s.stage, s.fn);
 }
 
 } // namespace

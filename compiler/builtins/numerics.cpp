@@ -51,6 +51,7 @@
 #include "base/primitive.hpp"
 #include "builtins/compiled_procedures.hpp"
 #include "builtins/integration_sites.hpp"
+#include "builtins/numeric_arguments.hpp"
 #include "builtins/numerics_defaults.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/procedure.hpp"
@@ -103,28 +104,20 @@ bool is_missing(Value *a, int n, int i) {
   return i >= n || a[i].is(Tag::Default);
 }
 
-double arg_real(Value *a, int i, const char *who) {
-  if (!is_number(a[i])) wrong_type(a[i], i + 1, who);
+// The arguments' values, read after check_numeric_arguments
+// (builtins/numeric_arguments.hpp) has checked them against the
+// primitive's signature, as sicm build checks them.
+double real_at(Value *a, int i) {
   return to_double(a[i]);
 }
 
-double arg_finite(Value *a, int i, const char *who) {
-  double x = arg_real(a, i, who);
-  if (!std::isfinite(x)) bad_range(a[i], i + 1, who);
-  return x;
+// An optional real: `fallback` when the argument is missing.
+double optional_real(Value *a, int n, int i, double fallback) {
+  return is_missing(a, n, i) ? fallback : to_double(a[i]);
 }
 
-// A tolerance: a positive finite real, or `fallback` when the argument is missing.
-double arg_tolerance(Value *a, int n, int i, double fallback, const char *who) {
-  if (is_missing(a, n, i)) return fallback;
-  double x = arg_real(a, i, who);
-  if (!(x > 0) || !std::isfinite(x)) bad_range(a[i], i + 1, who);
-  return x;
-}
-
-Value arg_procedure(Value *a, int i, const char *who) {
-  if (!is_procedure(a[i]) && !a[i].is(Tag::Structure)) wrong_type(a[i], i + 1, who);
-  return a[i];
+void check_arguments(const char *who, Value *a, int n, NativeProc *self = nullptr) {
+  check_numeric_arguments(numeric_signature(who), a, n, self);
 }
 
 std::string number_text(double x) {
@@ -568,10 +561,7 @@ const sicm_ode_step_type *arg_integrator(Value *a, int n, int i, const char *who
                                             kIntegratorList + ")");
     return T;
   }
-  const sicm_ode_step_type *T = is_symbol(a[i]) ? integrator_for(symbol_name(a[i])) : nullptr;
-  if (!T && is_symbol(a[i])) check_provided(symbol_name(a[i]), who);
-  if (!T) bad_range(a[i], i + 1, who);
-  return T;
+  return integrator_for(symbol_name(a[i])); // a name checked by check_arguments
 }
 
 // ---- one integration problem ----------------------------------------------------
@@ -686,7 +676,7 @@ struct OdeProblem {
 
 // The flat system derivative: (sysder . params), applied once.
 Value apply_sysder(Value *a, int n, const char *who) {
-  arg_procedure(a, 0, who);
+  if (!is_procedure(a[0])) wrong_type(a[0], 1, who); // as sicm build's sysder_of
   return apply_procedure(a[0], a + 1, n - 1);
 }
 
@@ -699,24 +689,14 @@ Value make_named_procedure(NativeFn fn, Value sysder, Lambda *lambda) {
   return p;
 }
 
-void check_arity(NativeProc *self, int given, int min, int max) {
-  if (given >= min && given <= max) return;
-  std::string name;
-  print_value(name, Value::object(Tag::Closure, &self->print_as), false);
-  runtime_error(current_call_loc(),
-                "The procedure " + name + " has been called with " + std::to_string(given) +
-                    (given == 1 ? " argument" : " arguments") + "; it requires between " +
-                    std::to_string(min) + " and " + std::to_string(max) + " arguments.");
-}
-
 // ((state-advancer sysder . params) state dt [eps [integrator]]): the state
 // dt later.
 Value advance_state(NativeProc *self, Value *a, int n) {
   static const char who[] = "state-advancer";
-  check_arity(self, n, 2, 4);
+  check_arguments(who, a, n, self);
   SrcLoc loc = current_call_loc();
-  double dt = arg_finite(a, 1, who);
-  double eps = arg_tolerance(a, n, 2, kAdvancerTolerance, who);
+  double dt = real_at(a, 1);
+  double eps = optional_real(a, n, 2, kAdvancerTolerance);
   const sicm_ode_step_type *T = arg_integrator(a, n, 3, who);
   OdeProblem p(loc, who, self->a, a[0], 1,
                T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended ||
@@ -774,31 +754,31 @@ private:
 // time (the last interval is shortened to end there); returns the final state.
 Value run_evolve(NativeProc *self, Value *a, int n) {
   static const char who[] = "evolve";
-  check_arity(self, n, 4, 6);
+  check_arguments(who, a, n, self);
   SrcLoc loc = current_call_loc();
-  Value monitor = arg_procedure(a, 1, who);
-  double dt = arg_finite(a, 2, who);
-  double t_final = arg_finite(a, 3, who);
-  double eps = arg_tolerance(a, n, 4, kAdvancerTolerance, who);
+  Value monitor = a[1];
+  double dt = real_at(a, 2);
+  double t_final = real_at(a, 3);
+  double eps = optional_real(a, n, 4, kAdvancerTolerance);
   const sicm_ode_step_type *T = arg_integrator(a, n, 5, who);
   OdeProblem p(loc, who, self->a, a[0], 1,
                T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended ||
                    recording_integration_sites());
-  if (dt == 0 && t_final != p.t0) bad_range(a[2], 3, who);
   p.record_site(who, t_final, eps, T);
-  const double step = std::fabs(dt) * (t_final >= p.t0 ? 1.0 : -1.0);
-  const double near_end = 1e-9 * std::fabs(step);
 
   Value state = a[0];
   apply_procedure(monitor, &state, 1);
+  // The times of the other calls: the runtime's schedule, which built
+  // programs walk too (sicm_drive_evolve).
+  sicm_monitor_schedule schedule;
+  if (const char *why_not = sicm_monitor_schedule_start(&schedule, p.t0, dt, t_final))
+    runtime_error(loc, std::string(who) + ": " + why_not);
   RuntimeErrorScope scope;
   OdePtr ode = p.make_integrator(T, eps);
   sicm_ode_set_horizon(ode.get(), t_final);
-  double t = p.t0;
+  double t = p.t0, tk;
   ProgressBar progress(p.t0, t_final);
-  for (long k = 1; std::fabs(t_final - t) > 0; ++k) {
-    double tk = p.t0 + static_cast<double>(k) * step;
-    if ((step > 0 ? t_final - tk : tk - t_final) <= near_end) tk = t_final;
+  while (sicm_monitor_schedule_next(&schedule, t, &tk)) {
     p.evolve_to(ode.get(), t, tk);
     state = p.state_at(tk);
     apply_procedure(monitor, &state, 1);
@@ -814,26 +794,23 @@ Value P_evolve(Value *a, int n) {
 // ---- quadrature -------------------------------------------------------------------
 
 // A limit of integration: a real, or :+infinity / :-infinity.
-double arg_limit(Value *a, int i, const char *who) {
+double limit_at(Value *a, int i) {
   if (is_symbol(a[i])) {
     const std::string &s = symbol_name(a[i]);
-    if (s == ":+infinity" || s == "+infinity") return INFINITY;
-    if (s == ":-infinity" || s == "-infinity") return -INFINITY;
-    wrong_type(a[i], i + 1, who);
+    return s == ":+infinity" || s == "+infinity" ? INFINITY : -INFINITY;
   }
-  double x = arg_real(a, i, who);
-  if (std::isnan(x)) bad_range(a[i], i + 1, who);
-  return x;
+  return to_double(a[i]);
 }
 
 // (definite-integral f a b [tolerance [compile?]]): the integral of f from a
 // to b to the relative tolerance (default 1e-11), by adaptive Gauss-Kronrod.
 Value P_definite_integral(Value *a, int n) {
   static const char who[] = "definite-integral";
+  check_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
-  Value f = arg_procedure(a, 0, who);
-  double lo = arg_limit(a, 1, who), hi = arg_limit(a, 2, who);
-  double tol = arg_tolerance(a, n, 3, kIntegralTolerance, who);
+  Value f = a[0];
+  double lo = limit_at(a, 1), hi = limit_at(a, 2);
+  double tol = optional_real(a, n, 3, kIntegralTolerance);
   if (lo == hi) return Value::fixnum(0);
   ScalarCallback cb(loc, who, f);
   RuntimeErrorScope scope;
@@ -868,11 +845,11 @@ Value P_definite_integral(Value *a, int n) {
 // (minimize f a b [tolerance]): Brent's method on [a, b]; the list
 // (argument value iterations), as scmutils' brent-min returns it.
 Value minimize_with(const char *who, Value *a, int n) {
+  check_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
-  Value f = arg_procedure(a, 0, who);
-  double lo = arg_finite(a, 1, who), hi = arg_finite(a, 2, who);
-  double tol = arg_tolerance(a, n, 3, kMinimizeTolerance, who);
-  if (lo == hi) bad_range(a[2], 3, who);
+  Value f = a[0];
+  double lo = real_at(a, 1), hi = real_at(a, 2);
+  double tol = optional_real(a, n, 3, kMinimizeTolerance);
   if (lo > hi) std::swap(lo, hi);
   ScalarCallback cb(loc, who, f);
   double xmin = 0, fmin = 0;
@@ -895,25 +872,17 @@ Value P_brent_min(Value *a, int n) {
 
 // The starting point of a multidimensional minimization: a list or a vector
 // of reals.
-std::vector<double> arg_point(Value *a, int i, const char *who, bool &is_list) {
+std::vector<double> point_at(Value *a, int i, bool &is_list) {
   std::vector<double> x;
   is_list = !a[i].is(Tag::Vector);
   if (is_list) {
-    if (list_length(a[i]) <= 0) wrong_type(a[i], i + 1, who);
-    for (Value l = a[i]; is_pair(l); l = cdr(l)) {
-      if (!is_number(car(l))) wrong_type(a[i], i + 1, who);
+    for (Value l = a[i]; is_pair(l); l = cdr(l))
       x.push_back(to_double(car(l)));
-    }
   } else {
     Vector *v = a[i].vector();
-    if (v->len == 0) wrong_type(a[i], i + 1, who);
-    for (size_t k = 0; k < v->len; ++k) {
-      if (!is_number(v->items[k])) wrong_type(a[i], i + 1, who);
+    for (size_t k = 0; k < v->len; ++k)
       x.push_back(to_double(v->items[k]));
-    }
   }
-  for (double c : x)
-    if (!std::isfinite(c)) bad_range(a[i], i + 1, who);
   return x;
 }
 
@@ -944,14 +913,14 @@ NelderMeadResult nelder_mead(VectorCallback &cb, std::vector<double> x, double s
 // iterations ran out.
 Value P_nelder_mead(Value *a, int n) {
   static const char who[] = "nelder-mead";
+  check_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
-  Value f = arg_procedure(a, 0, who);
+  Value f = a[0];
   bool is_list;
-  std::vector<double> x = arg_point(a, 1, who, is_list);
-  double step = arg_tolerance(a, n, 2, kNelderStep, who);
-  double tol = arg_tolerance(a, n, 3, kNelderTolerance, who);
-  int max_iter =
-      is_missing(a, n, 4) ? kNelderMaxIter : static_cast<int>(arg_bounded(a, 4, 1, 100000000, who));
+  std::vector<double> x = point_at(a, 1, is_list);
+  double step = optional_real(a, n, 2, kNelderStep);
+  double tol = optional_real(a, n, 3, kNelderTolerance);
+  int max_iter = is_missing(a, n, 4) ? kNelderMaxIter : static_cast<int>(a[4].i);
   VectorCallback cb(loc, who, f, x.size(), false);
   NelderMeadResult r = nelder_mead(cb, std::move(x), step, tol, max_iter);
   Value best = cons(point_value(r.x.data(), r.x.size(), false), Value::flonum(r.fmin));
@@ -964,11 +933,12 @@ Value P_nelder_mead(Value *a, int n) {
 // by Nelder-Mead; the result has the initial point's type.
 Value P_multidimensional_minimize(Value *a, int n) {
   static const char who[] = "multidimensional-minimize";
+  check_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
-  Value f = arg_procedure(a, 0, who);
+  Value f = a[0];
   bool is_list;
-  std::vector<double> x = arg_point(a, 1, who, is_list);
-  double tol = arg_tolerance(a, n, 2, kNelderTolerance, who);
+  std::vector<double> x = point_at(a, 1, is_list);
+  double tol = optional_real(a, n, 2, kNelderTolerance);
   VectorCallback cb(loc, who, f, x.size(), is_list);
   NelderMeadResult r = nelder_mead(cb, std::move(x), kNelderStep, tol, kNelderMaxIter * 20);
   if (r.status != SICM_SUCCESS)
@@ -986,16 +956,12 @@ Value P_multidimensional_minimize(Value *a, int n) {
 // by Brent's method (full precision by default).
 Value P_find_root(Value *a, int n) {
   static const char who[] = "find-root";
+  check_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
-  Value f = arg_procedure(a, 0, who);
-  double lo = arg_finite(a, 1, who), hi = arg_finite(a, 2, who);
-  double tol = 0;
-  if (!is_missing(a, n, 3)) {
-    tol = arg_real(a, 3, who);
-    if (!(tol >= 0) || !std::isfinite(tol)) bad_range(a[3], 4, who);
-  }
+  Value f = a[0];
+  double lo = real_at(a, 1), hi = real_at(a, 2);
+  double tol = optional_real(a, n, 3, 0.0);
   if (lo > hi) std::swap(lo, hi);
-  if (lo == hi) bad_range(a[2], 3, who);
   ScalarCallback cb(loc, who, f);
   double f_lo = call_scalar(lo, &cb), f_hi = call_scalar(hi, &cb);
   cb.rethrow_if_failed();
@@ -1020,12 +986,12 @@ Value P_find_root(Value *a, int n) {
 // The runtime's sicm_root_bisect takes the steps, as in built programs.
 Value P_bisect(Value *a, int n) {
   static const char who[] = "bisect";
+  check_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
-  Value f = arg_procedure(a, 0, who);
-  double x0 = arg_finite(a, 1, who), x1 = arg_finite(a, 2, who);
-  double eps = arg_real(a, 3, who);
-  if (!(eps >= 0)) bad_range(a[3], 4, who);
-  long n_break = is_missing(a, n, 4) ? kBisectBreak : static_cast<long>(arg_index(a, 4, who));
+  Value f = a[0];
+  double x0 = real_at(a, 1), x1 = real_at(a, 2);
+  double eps = real_at(a, 3);
+  long n_break = is_missing(a, n, 4) ? kBisectBreak : static_cast<long>(a[4].i);
   ScalarCallback cb(loc, who, f);
   cb.compile_expensive = true;
   double root = 0, bracket[2], values[2];
@@ -1089,6 +1055,10 @@ std::string integrator_not_provided(const std::string &name) {
   return "";
 }
 
+const char *integrator_list() {
+  return kIntegratorList;
+}
+
 const char *integrator_c_name(const std::string &name) {
   const IntegratorName *i = find_integrator(name);
   return i ? i->c_name : nullptr;
@@ -1104,17 +1074,17 @@ void install_numerics_primitives() {
   g_advancer_lambda.name = intern("state-advancer").symbol();
   g_evolver_lambda.name = intern("evolve").symbol();
 
-  define_primitive("definite-integral", 3, 5, P_definite_integral);
-  define_primitive("minimize", 3, 4, P_minimize);
-  define_primitive("brent-min", 3, 4, P_brent_min);
-  define_primitive("nelder-mead", 2, 5, P_nelder_mead);
-  define_primitive("multidimensional-minimize", 2, 3, P_multidimensional_minimize);
-  define_primitive("find-root", 3, 4, P_find_root);
-  define_primitive("bisect", 4, 5, P_bisect);
-  define_primitive("state-advancer", 1, kVariadic, P_state_advancer);
-  define_primitive("evolve", 1, kVariadic, P_evolve);
-  define_primitive("eigenvalues", 1, 1, P_eigenvalues);
-  define_primitive("matrix->eigenvalues", 1, 1, P_eigenvalues);
+  define_primitive("definite-integral", 3, 5, Stage::RunTime, P_definite_integral);
+  define_primitive("minimize", 3, 4, Stage::RunTime, P_minimize);
+  define_primitive("brent-min", 3, 4, Stage::RunTime, P_brent_min);
+  define_primitive("nelder-mead", 2, 5, Stage::RunTime, P_nelder_mead);
+  define_primitive("multidimensional-minimize", 2, 3, Stage::RunTime, P_multidimensional_minimize);
+  define_primitive("find-root", 3, 4, Stage::RunTime, P_find_root);
+  define_primitive("bisect", 4, 5, Stage::RunTime, P_bisect);
+  define_primitive("state-advancer", 1, kVariadic, Stage::RunTime, P_state_advancer);
+  define_primitive("evolve", 1, kVariadic, Stage::RunTime, P_evolve);
+  define_primitive("eigenvalues", 1, 1, Stage::Pure, P_eigenvalues);
+  define_primitive("matrix->eigenvalues", 1, 1, Stage::Pure, P_eigenvalues);
 }
 
 } // namespace sicm

@@ -26,6 +26,9 @@ const char *integrator_c_name(const std::string &name);
 // The runtime's step type for an integrator's name, or null.
 const sicm_ode_step_type *integrator_named(const std::string &name);
 
+// The integrators' names, for messages ("bulirsch-stoer, rk8pd, ...").
+const char *integrator_list();
+
 // For an integrator of scmutils that sicm does not provide ('implicit-gear),
 // a message saying so and what to use instead; "" for any other name.
 std::string integrator_not_provided(const std::string &name);

@@ -98,7 +98,7 @@ std::string undeclared_parameter_error() {
 }
 
 void install_parameter_primitives() {
-  define_primitive("parameter", 2, 2, P_parameter);
+  define_primitive("parameter", 2, 2, Stage::RunTime, P_parameter);
 }
 
 } // namespace sicm

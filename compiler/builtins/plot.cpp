@@ -112,11 +112,11 @@ void set_plot_directory(const std::string &dir) {
 }
 
 void install_plot_primitives() {
-  define_primitive("frame", 4, 7, P_frame);
-  define_primitive("plot-point", 3, 3, P_plot_point);
-  define_primitive("plot-line", 5, 5, P_plot_line);
-  define_primitive("graphics-close", 1, 1, P_graphics_close);
-  define_primitive("graphics-clear", 1, 1, P_graphics_clear);
+  define_primitive("frame", 4, 7, Stage::Effect, P_frame);
+  define_primitive("plot-point", 3, 3, Stage::Effect, P_plot_point);
+  define_primitive("plot-line", 5, 5, Stage::Effect, P_plot_line);
+  define_primitive("graphics-close", 1, 1, Stage::Effect, P_graphics_close);
+  define_primitive("graphics-clear", 1, 1, Stage::Effect, P_graphics_clear);
 }
 
 } // namespace sicm

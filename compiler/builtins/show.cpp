@@ -64,9 +64,9 @@ Value P_to_tex_string(Value *a, int) {
 } // namespace
 
 void install_show_primitives() {
-  define_primitive("show-expression", 1, 1, P_show_expression);
-  define_primitive("->infix", 1, 1, P_to_infix);
-  define_primitive("->tex-string", 1, 1, P_to_tex_string);
+  define_primitive("show-expression", 1, 1, Stage::Effect, P_show_expression);
+  define_primitive("->infix", 1, 1, Stage::Pure, P_to_infix);
+  define_primitive("->tex-string", 1, 1, Stage::Pure, P_to_tex_string);
 }
 
 } // namespace sicm

@@ -226,66 +226,66 @@ Value pad(Value *args, int nargs, bool left, const char *who) {
 int64_t g_symbol_counter = 10;
 
 void install_characters() {
-  define_primitive("char?", 1, 1, [](Value *a, int) { return boolean(a[0].is(Tag::Char)); });
-  define_primitive("char->integer", 1, 1,
+  define_primitive("char?", 1, 1, Stage::Pure, [](Value *a, int) { return boolean(a[0].is(Tag::Char)); });
+  define_primitive("char->integer", 1, 1, Stage::Pure,
                    [](Value *a, int) { return Value::fixnum(arg_char(a, 0, "char->integer")); });
-  define_primitive("integer->char", 1, 1, [](Value *a, int) {
+  define_primitive("integer->char", 1, 1, Stage::Pure, [](Value *a, int) {
     if (!a[0].is(Tag::Fixnum)) wrong_type(a[0], 1, "integer->char");
     int64_t n = a[0].i;
     if (n < 0 || n > 0x10FFFF || (n >= 0xD800 && n <= 0xDFFF)) bad_range(a[0], 1, "integer->char");
     return Value::character(static_cast<uint32_t>(n));
   });
-  define_primitive("char=?", 1, kVariadic,
+  define_primitive("char=?", 1, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return compare_chars(a, n, "char=?", Cmp::Eq, false); });
-  define_primitive("char<?", 1, kVariadic,
+  define_primitive("char<?", 1, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return compare_chars(a, n, "char<?", Cmp::Lt, false); });
-  define_primitive("char>?", 1, kVariadic,
+  define_primitive("char>?", 1, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return compare_chars(a, n, "char>?", Cmp::Gt, false); });
-  define_primitive("char<=?", 1, kVariadic,
+  define_primitive("char<=?", 1, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return compare_chars(a, n, "char<=?", Cmp::Le, false); });
-  define_primitive("char>=?", 1, kVariadic,
+  define_primitive("char>=?", 1, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return compare_chars(a, n, "char>=?", Cmp::Ge, false); });
-  define_primitive("char-ci=?", 1, kVariadic,
+  define_primitive("char-ci=?", 1, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return compare_chars(a, n, "char-ci=?", Cmp::Eq, true); });
-  define_primitive("char-upcase", 1, 1, [](Value *a, int) {
+  define_primitive("char-upcase", 1, 1, Stage::Pure, [](Value *a, int) {
     return Value::character(upcase(arg_char(a, 0, "char-upcase")));
   });
-  define_primitive("char-downcase", 1, 1, [](Value *a, int) {
+  define_primitive("char-downcase", 1, 1, Stage::Pure, [](Value *a, int) {
     return Value::character(downcase(arg_char(a, 0, "char-downcase")));
   });
-  define_primitive("char-alphabetic?", 1, 1, [](Value *a, int) {
+  define_primitive("char-alphabetic?", 1, 1, Stage::Pure, [](Value *a, int) {
     return boolean(is_alphabetic(arg_char(a, 0, "char-alphabetic?")));
   });
-  define_primitive("char-numeric?", 1, 1, [](Value *a, int) {
+  define_primitive("char-numeric?", 1, 1, Stage::Pure, [](Value *a, int) {
     return boolean(is_numeric(arg_char(a, 0, "char-numeric?")));
   });
-  define_primitive("char-whitespace?", 1, 1, [](Value *a, int) {
+  define_primitive("char-whitespace?", 1, 1, Stage::Pure, [](Value *a, int) {
     return boolean(is_whitespace(arg_char(a, 0, "char-whitespace?")));
   });
-  define_primitive("char-upper-case?", 1, 1, [](Value *a, int) {
+  define_primitive("char-upper-case?", 1, 1, Stage::Pure, [](Value *a, int) {
     return boolean(is_upper(arg_char(a, 0, "char-upper-case?")));
   });
-  define_primitive("char-lower-case?", 1, 1, [](Value *a, int) {
+  define_primitive("char-lower-case?", 1, 1, Stage::Pure, [](Value *a, int) {
     return boolean(is_lower(arg_char(a, 0, "char-lower-case?")));
   });
-  define_primitive("digit-value", 1, 1, [](Value *a, int) {
+  define_primitive("digit-value", 1, 1, Stage::Pure, [](Value *a, int) {
     uint32_t c = arg_char(a, 0, "digit-value");
     return is_numeric(c) ? Value::fixnum(c - '0') : boolean(false);
   });
-  define_primitive("char->digit", 1, 2, [](Value *a, int n) {
+  define_primitive("char->digit", 1, 2, Stage::Pure, [](Value *a, int n) {
     uint32_t c = arg_char(a, 0, "char->digit");
     int radix = arg_radix(a, n, 1, "char->digit");
     int d = digit_of(c);
     return d >= 0 && d < radix ? Value::fixnum(d) : boolean(false);
   });
-  define_primitive("digit->char", 1, 2, [](Value *a, int n) {
+  define_primitive("digit->char", 1, 2, Stage::Pure, [](Value *a, int n) {
     if (!a[0].is(Tag::Fixnum)) wrong_type(a[0], 1, "digit->char");
     int radix = arg_radix(a, n, 1, "digit->char");
     int64_t d = a[0].i;
     if (d < 0 || d >= radix) return boolean(false);
     return Value::character(static_cast<uint32_t>("0123456789abcdefghijklmnopqrstuvwxyz"[d]));
   });
-  define_primitive("char->string", 1, 1, [](Value *a, int) {
+  define_primitive("char->string", 1, 1, Stage::Pure, [](Value *a, int) {
     std::string s;
     append_utf8(s, arg_char(a, 0, "char->string"));
     return str(s);
@@ -293,8 +293,8 @@ void install_characters() {
 }
 
 void install_strings() {
-  define_primitive("string?", 1, 1, [](Value *a, int) { return boolean(a[0].is(Tag::String)); });
-  define_primitive("make-string", 1, 2, [](Value *a, int n) {
+  define_primitive("string?", 1, 1, Stage::Pure, [](Value *a, int) { return boolean(a[0].is(Tag::String)); });
+  define_primitive("make-string", 1, 2, Stage::Pure, [](Value *a, int n) {
     size_t k = arg_count(a, 0, "make-string");
     uint32_t fill = supplied(a, n, 1) ? arg_char(a, 1, "make-string") : ' ';
     std::string s;
@@ -302,19 +302,19 @@ void install_strings() {
       append_utf8(s, fill);
     return str(s);
   });
-  define_primitive("string", 0, kVariadic,
+  define_primitive("string", 0, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return str(display_concat(a, n)); });
-  define_primitive("string-length", 1, 1, [](Value *a, int) {
+  define_primitive("string-length", 1, 1, Stage::Pure, [](Value *a, int) {
     return Value::fixnum(static_cast<int64_t>(arg_str(a, 0, "string-length")->len));
   });
-  define_primitive("string-ref", 2, 2, [](Value *a, int) {
+  define_primitive("string-ref", 2, 2, Stage::Pure, [](Value *a, int) {
     String *s = arg_str(a, 0, "string-ref");
     if (!a[1].is(Tag::Fixnum)) wrong_type(a[1], 2, "string-ref");
     if (a[1].i < 0 || static_cast<size_t>(a[1].i) >= s->len) bad_range(a[1], 2, "string-ref");
     size_t n;
     return Value::character(get_utf8(string_view(a[0]), static_cast<size_t>(a[1].i), &n));
   });
-  define_primitive("string-set!", 3, 3, [](Value *a, int) {
+  define_primitive("string-set!", 3, 3, Stage::Effect, [](Value *a, int) {
     String *s = arg_str(a, 0, "string-set!");
     refuse_change_of(a[0], "string-set!");
     if (!a[1].is(Tag::Fixnum)) wrong_type(a[1], 2, "string-set!");
@@ -327,23 +327,23 @@ void install_strings() {
     splice(s, pos, n, text);
     return Value::unspecified();
   });
-  define_primitive("substring", 2, 3, [](Value *a, int n) {
+  define_primitive("substring", 2, 3, Stage::Pure, [](Value *a, int n) {
     arg_str(a, 0, "substring");
     std::string_view s = string_view(a[0]);
     auto [start, end] = arg_span(a, n, 1, s.size(), "substring");
     return str(s.substr(start, end - start));
   });
-  define_primitive("string-head", 2, 2, [](Value *a, int) {
+  define_primitive("string-head", 2, 2, Stage::Pure, [](Value *a, int) {
     arg_str(a, 0, "string-head");
     std::string_view s = string_view(a[0]);
     return str(s.substr(0, arg_bounded(a, 1, 0, s.size(), "string-head")));
   });
-  define_primitive("string-tail", 2, 2, [](Value *a, int) {
+  define_primitive("string-tail", 2, 2, Stage::Pure, [](Value *a, int) {
     arg_str(a, 0, "string-tail");
     std::string_view s = string_view(a[0]);
     return str(s.substr(arg_bounded(a, 1, 0, s.size(), "string-tail")));
   });
-  define_primitive("string-append", 0, kVariadic, [](Value *a, int n) {
+  define_primitive("string-append", 0, kVariadic, Stage::Pure, [](Value *a, int n) {
     std::string out;
     for (int i = 0; i < n; ++i) {
       arg_str(a, i, "string-append");
@@ -351,19 +351,19 @@ void install_strings() {
     }
     return str(out);
   });
-  define_primitive("string-copy", 1, 3, [](Value *a, int n) {
+  define_primitive("string-copy", 1, 3, Stage::Pure, [](Value *a, int n) {
     arg_str(a, 0, "string-copy");
     std::string_view s = string_view(a[0]);
     auto [start, end] = arg_span(a, n, 1, s.size(), "string-copy");
     return str(s.substr(start, end - start));
   });
-  define_primitive("string->list", 1, 3, [](Value *a, int n) {
+  define_primitive("string->list", 1, 3, Stage::Pure, [](Value *a, int n) {
     arg_str(a, 0, "string->list");
     std::string_view s = string_view(a[0]);
     auto [start, end] = arg_span(a, n, 1, s.size(), "string->list");
     return list_from_string(s, start, end);
   });
-  define_primitive("list->string", 1, 1, [](Value *a, int) {
+  define_primitive("list->string", 1, 1, Stage::Pure, [](Value *a, int) {
     if (list_length(a[0]) < 0) wrong_type(a[0], 1, "list->string");
     std::string out;
     for (Value p = a[0]; is_pair(p); p = cdr(p)) {
@@ -372,17 +372,17 @@ void install_strings() {
     }
     return str(out);
   });
-  define_primitive("string-null?", 1, 1,
+  define_primitive("string-null?", 1, 1, Stage::Pure,
                    [](Value *a, int) { return boolean(arg_str(a, 0, "string-null?")->len == 0); });
-  define_primitive("string-upcase", 1, 1, [](Value *a, int) {
+  define_primitive("string-upcase", 1, 1, Stage::Pure, [](Value *a, int) {
     arg_str(a, 0, "string-upcase");
     return str(fold_case(string_view(a[0]), true));
   });
-  define_primitive("string-downcase", 1, 1, [](Value *a, int) {
+  define_primitive("string-downcase", 1, 1, Stage::Pure, [](Value *a, int) {
     arg_str(a, 0, "string-downcase");
     return str(fold_case(string_view(a[0]), false));
   });
-  define_primitive("string-reverse", 1, 1, [](Value *a, int) {
+  define_primitive("string-reverse", 1, 1, Stage::Pure, [](Value *a, int) {
     arg_str(a, 0, "string-reverse");
     // Reverse characters, not bytes, so multi-byte characters stay intact.
     std::string_view s = string_view(a[0]);
@@ -396,27 +396,27 @@ void install_strings() {
     return str(out);
   });
 
-  define_primitive("string=?", 1, kVariadic, [](Value *a, int n) {
+  define_primitive("string=?", 1, kVariadic, Stage::Pure, [](Value *a, int n) {
     return compare_strings(a, n, "string=?", Cmp::Eq, false);
   });
-  define_primitive("string<?", 1, kVariadic, [](Value *a, int n) {
+  define_primitive("string<?", 1, kVariadic, Stage::Pure, [](Value *a, int n) {
     return compare_strings(a, n, "string<?", Cmp::Lt, false);
   });
-  define_primitive("string>?", 1, kVariadic, [](Value *a, int n) {
+  define_primitive("string>?", 1, kVariadic, Stage::Pure, [](Value *a, int n) {
     return compare_strings(a, n, "string>?", Cmp::Gt, false);
   });
-  define_primitive("string<=?", 1, kVariadic, [](Value *a, int n) {
+  define_primitive("string<=?", 1, kVariadic, Stage::Pure, [](Value *a, int n) {
     return compare_strings(a, n, "string<=?", Cmp::Le, false);
   });
-  define_primitive("string>=?", 1, kVariadic, [](Value *a, int n) {
+  define_primitive("string>=?", 1, kVariadic, Stage::Pure, [](Value *a, int n) {
     return compare_strings(a, n, "string>=?", Cmp::Ge, false);
   });
-  define_primitive("string-ci=?", 1, kVariadic, [](Value *a, int n) {
+  define_primitive("string-ci=?", 1, kVariadic, Stage::Pure, [](Value *a, int n) {
     return compare_strings(a, n, "string-ci=?", Cmp::Eq, true);
   });
 
   // (string-index string char-or-predicate [start end]) -> index or #f
-  define_primitive("string-index", 2, 4, [](Value *a, int n) {
+  define_primitive("string-index", 2, 4, Stage::Pure, [](Value *a, int n) {
     arg_str(a, 0, "string-index");
     if (!a[1].is(Tag::Char) && !is_procedure(a[1])) wrong_type(a[1], 2, "string-index");
     auto [start, end] = arg_span(a, n, 2, string_view(a[0]).size(), "string-index");
@@ -432,7 +432,7 @@ void install_strings() {
     }
     return boolean(false);
   });
-  define_primitive("string-search-forward", 2, 3, [](Value *a, int n) {
+  define_primitive("string-search-forward", 2, 3, Stage::Pure, [](Value *a, int n) {
     std::string_view pattern = arg_string(a, 0, "string-search-forward");
     std::string_view s = arg_string(a, 1, "string-search-forward");
     size_t start = supplied(a, n, 2) ? arg_bounded(a, 2, 0, s.size(), "string-search-forward") : 0;
@@ -440,7 +440,7 @@ void install_strings() {
     return at == std::string_view::npos ? boolean(false) : Value::fixnum(static_cast<int64_t>(at));
   });
   // MIT returns the index just after the match, the place a backward scan stops.
-  define_primitive("string-search-backward", 2, 3, [](Value *a, int n) {
+  define_primitive("string-search-backward", 2, 3, Stage::Pure, [](Value *a, int n) {
     std::string_view pattern = arg_string(a, 0, "string-search-backward");
     std::string_view s = arg_string(a, 1, "string-search-backward");
     size_t end =
@@ -451,7 +451,7 @@ void install_strings() {
                                         : Value::fixnum(static_cast<int64_t>(at + pattern.size()));
   });
   // Every index where pattern occurs, overlapping matches included.
-  define_primitive("string-search-all", 2, 4, [](Value *a, int n) {
+  define_primitive("string-search-all", 2, 4, Stage::Pure, [](Value *a, int n) {
     std::string_view pattern = arg_string(a, 0, "string-search-all");
     std::string_view s = arg_string(a, 1, "string-search-all");
     auto [start, end] = arg_span(a, n, 2, s.size(), "string-search-all");
@@ -461,22 +461,22 @@ void install_strings() {
       hits.push_back(Value::fixnum(static_cast<int64_t>(at)));
     return list_from(hits.data(), hits.size());
   });
-  define_primitive("string-prefix?", 2, 2, [](Value *a, int) {
+  define_primitive("string-prefix?", 2, 2, Stage::Pure, [](Value *a, int) {
     std::string_view p = arg_string(a, 0, "string-prefix?");
     std::string_view s = arg_string(a, 1, "string-prefix?");
     return boolean(s.substr(0, p.size()) == p);
   });
-  define_primitive("string-suffix?", 2, 2, [](Value *a, int) {
+  define_primitive("string-suffix?", 2, 2, Stage::Pure, [](Value *a, int) {
     std::string_view p = arg_string(a, 0, "string-suffix?");
     std::string_view s = arg_string(a, 1, "string-suffix?");
     return boolean(s.size() >= p.size() && s.substr(s.size() - p.size()) == p);
   });
-  define_primitive("string-pad-left", 2, 3,
+  define_primitive("string-pad-left", 2, 3, Stage::Pure,
                    [](Value *a, int n) { return pad(a, n, true, "string-pad-left"); });
-  define_primitive("string-pad-right", 2, 3,
+  define_primitive("string-pad-right", 2, 3, Stage::Pure,
                    [](Value *a, int n) { return pad(a, n, false, "string-pad-right"); });
   // (string-join strings [delimiter]): the delimiter defaults to a space.
-  define_primitive("string-join", 1, 2, [](Value *a, int n) {
+  define_primitive("string-join", 1, 2, Stage::Pure, [](Value *a, int n) {
     if (list_length(a[0]) < 0) wrong_type(a[0], 1, "string-join");
     std::string_view delim = " ";
     if (supplied(a, n, 1)) delim = arg_string(a, 1, "string-join");
@@ -491,28 +491,28 @@ void install_strings() {
 }
 
 void install_symbols() {
-  define_primitive("symbol?", 1, 1, [](Value *a, int) { return boolean(is_symbol(a[0])); });
-  define_primitive("symbol->string", 1, 1,
+  define_primitive("symbol?", 1, 1, Stage::Pure, [](Value *a, int) { return boolean(is_symbol(a[0])); });
+  define_primitive("symbol->string", 1, 1, Stage::Pure,
                    [](Value *a, int) { return str(arg_symbol(a, 0, "symbol->string")->name); });
-  define_primitive("string->symbol", 1, 1,
+  define_primitive("string->symbol", 1, 1, Stage::Pure,
                    [](Value *a, int) { return intern(arg_string(a, 0, "string->symbol")); });
-  define_primitive("intern", 1, 1,
+  define_primitive("intern", 1, 1, Stage::Pure,
                    [](Value *a, int) { return intern(arg_string(a, 0, "intern")); });
-  define_primitive("string->uninterned-symbol", 1, 1, [](Value *a, int) {
+  define_primitive("string->uninterned-symbol", 1, 1, Stage::Pure, [](Value *a, int) {
     return make_uninterned_symbol(arg_string(a, 0, "string->uninterned-symbol"));
   });
-  define_primitive("symbol-append", 0, kVariadic, [](Value *a, int n) {
+  define_primitive("symbol-append", 0, kVariadic, Stage::Pure, [](Value *a, int n) {
     std::string name;
     for (int i = 0; i < n; ++i)
       name += arg_symbol(a, i, "symbol-append")->name;
     return intern(name);
   });
   // (symbol obj ...): MIT interns the concatenated display forms.
-  define_primitive("symbol", 0, kVariadic,
+  define_primitive("symbol", 0, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return intern(display_concat(a, n)); });
   // (generate-uninterned-symbol [prefix]): a fresh symbol named like g12; a
   // symbol or string argument replaces the "g".
-  define_primitive("generate-uninterned-symbol", 0, 1, [](Value *a, int n) {
+  define_primitive("generate-uninterned-symbol", 0, 1, Stage::Pure, [](Value *a, int n) {
     std::string name = "g";
     if (supplied(a, n, 0)) {
       if (is_symbol(a[0]))
@@ -523,7 +523,7 @@ void install_symbols() {
     name += std::to_string(++g_symbol_counter);
     return make_uninterned_symbol(name);
   });
-  define_primitive("symbol<?", 1, kVariadic, [](Value *a, int n) {
+  define_primitive("symbol<?", 1, kVariadic, Stage::Pure, [](Value *a, int n) {
     for (int i = 0; i < n; ++i)
       arg_symbol(a, i, "symbol<?");
     bool ok = true;

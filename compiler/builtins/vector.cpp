@@ -79,38 +79,38 @@ Value map_or_for_each(Value *args, int nargs, bool collect, const char *who) {
 }
 
 void install_basics() {
-  define_primitive("vector?", 1, 1,
+  define_primitive("vector?", 1, 1, Stage::Pure,
                    [](Value *a, int) { return Value::boolean(a[0].is(Tag::Vector)); });
   // MIT fills with #f when no fill is given.
-  define_primitive("make-vector", 1, 2, [](Value *a, int n) {
+  define_primitive("make-vector", 1, 2, Stage::Pure, [](Value *a, int n) {
     size_t len = arg_size(a, 0, "make-vector");
     return make_vector(len, supplied(a, n, 1) ? a[1] : Value::boolean(false));
   });
-  define_primitive("vector", 0, kVariadic, [](Value *a, int n) {
+  define_primitive("vector", 0, kVariadic, Stage::Pure, [](Value *a, int n) {
     Value v = make_vector(static_cast<size_t>(n), Value::boolean(false));
     for (int i = 0; i < n; ++i)
       v.vector()->items[i] = a[i];
     return v;
   });
-  define_primitive("vector-length", 1, 1, [](Value *a, int) {
+  define_primitive("vector-length", 1, 1, Stage::Pure, [](Value *a, int) {
     return Value::fixnum(static_cast<int64_t>(arg_vector(a, 0, "vector-length")->len));
   });
-  define_primitive("vector-ref", 2, 2, [](Value *a, int) {
+  define_primitive("vector-ref", 2, 2, Stage::Pure, [](Value *a, int) {
     Vector *v = arg_vector(a, 0, "vector-ref");
     return v->items[arg_element(a, 1, v, "vector-ref")];
   });
-  define_primitive("vector-set!", 3, 3, [](Value *a, int) {
+  define_primitive("vector-set!", 3, 3, Stage::Effect, [](Value *a, int) {
     Vector *v = arg_vector(a, 0, "vector-set!");
     refuse_change_of(a[0], "vector-set!");
     v->items[arg_element(a, 1, v, "vector-set!")] = a[2];
     return Value::unspecified();
   });
-  define_primitive("vector-first", 1, 1, [](Value *a, int) {
+  define_primitive("vector-first", 1, 1, Stage::Pure, [](Value *a, int) {
     Vector *v = arg_vector(a, 0, "vector-first");
     if (v->len == 0) wrong_type(a[0], 1, "vector-first");
     return v->items[0];
   });
-  define_primitive("vector-last", 1, 1, [](Value *a, int) {
+  define_primitive("vector-last", 1, 1, Stage::Pure, [](Value *a, int) {
     Vector *v = arg_vector(a, 0, "vector-last");
     if (v->len == 0) wrong_type(a[0], 1, "vector-last");
     return v->items[v->len - 1];
@@ -118,17 +118,17 @@ void install_basics() {
 }
 
 void install_conversions() {
-  define_primitive("vector->list", 1, 3, [](Value *a, int n) {
+  define_primitive("vector->list", 1, 3, Stage::Pure, [](Value *a, int n) {
     Vector *v = arg_vector(a, 0, "vector->list");
     auto [start, end] = arg_span(a, n, 1, v->len, "vector->list");
     return list_of(v, start, end);
   });
-  define_primitive("subvector->list", 3, 3, [](Value *a, int n) {
+  define_primitive("subvector->list", 3, 3, Stage::Pure, [](Value *a, int n) {
     Vector *v = arg_vector(a, 0, "subvector->list");
     auto [start, end] = arg_span(a, n, 1, v->len, "subvector->list");
     return list_of(v, start, end);
   });
-  define_primitive("list->vector", 1, 1, [](Value *a, int) {
+  define_primitive("list->vector", 1, 1, Stage::Pure, [](Value *a, int) {
     long len = list_length(a[0]);
     if (len < 0) wrong_type(a[0], 1, "list->vector");
     Value v = make_vector(static_cast<size_t>(len), Value::boolean(false));
@@ -140,26 +140,26 @@ void install_conversions() {
 }
 
 void install_slices() {
-  define_primitive("subvector", 3, 3, [](Value *a, int n) {
+  define_primitive("subvector", 3, 3, Stage::Pure, [](Value *a, int n) {
     Vector *v = arg_vector(a, 0, "subvector");
     auto [start, end] = arg_span(a, n, 1, v->len, "subvector");
     return slice(v, start, end);
   });
-  define_primitive("vector-head", 2, 2, [](Value *a, int) {
+  define_primitive("vector-head", 2, 2, Stage::Pure, [](Value *a, int) {
     Vector *v = arg_vector(a, 0, "vector-head");
     return slice(v, 0, arg_bounded(a, 1, 0, v->len, "vector-head"));
   });
-  define_primitive("vector-tail", 2, 2, [](Value *a, int) {
+  define_primitive("vector-tail", 2, 2, Stage::Pure, [](Value *a, int) {
     Vector *v = arg_vector(a, 0, "vector-tail");
     return slice(v, arg_bounded(a, 1, 0, v->len, "vector-tail"), v->len);
   });
-  define_primitive("vector-copy", 1, 3, [](Value *a, int n) {
+  define_primitive("vector-copy", 1, 3, Stage::Pure, [](Value *a, int n) {
     Vector *v = arg_vector(a, 0, "vector-copy");
     auto [start, end] = arg_span(a, n, 1, v->len, "vector-copy");
     return slice(v, start, end);
   });
   // (vector-copy! to at from [start end]), R7RS; overlapping ranges are safe.
-  define_primitive("vector-copy!", 3, 5, [](Value *a, int n) {
+  define_primitive("vector-copy!", 3, 5, Stage::Effect, [](Value *a, int n) {
     Vector *to = arg_vector(a, 0, "vector-copy!");
     refuse_change_of(a[0], "vector-copy!");
     size_t at = arg_bounded(a, 1, 0, to->len, "vector-copy!");
@@ -175,7 +175,7 @@ void install_slices() {
     }
     return Value::unspecified();
   });
-  define_primitive("vector-append", 0, kVariadic, [](Value *a, int n) {
+  define_primitive("vector-append", 0, kVariadic, Stage::Pure, [](Value *a, int n) {
     size_t total = 0;
     for (int i = 0; i < n; ++i)
       total += arg_vector(a, i, "vector-append")->len;
@@ -187,7 +187,7 @@ void install_slices() {
     return out;
   });
   // (vector-grow v n): a longer copy; MIT leaves the new slots unassigned, we use #f.
-  define_primitive("vector-grow", 2, 2, [](Value *a, int) {
+  define_primitive("vector-grow", 2, 2, Stage::Pure, [](Value *a, int) {
     Vector *v = arg_vector(a, 0, "vector-grow");
     size_t len = arg_size(a, 1, "vector-grow");
     if (len < v->len) bad_range(a[1], 2, "vector-grow");
@@ -196,7 +196,7 @@ void install_slices() {
       out.vector()->items[i] = v->items[i];
     return out;
   });
-  define_primitive("vector-fill!", 2, 4, [](Value *a, int n) {
+  define_primitive("vector-fill!", 2, 4, Stage::Effect, [](Value *a, int n) {
     Vector *v = arg_vector(a, 0, "vector-fill!");
     refuse_change_of(a[0], "vector-fill!");
     auto [start, end] = arg_span(a, n, 2, v->len, "vector-fill!");
@@ -207,12 +207,12 @@ void install_slices() {
 }
 
 void install_higher_order() {
-  define_primitive("vector-map", 2, kVariadic,
+  define_primitive("vector-map", 2, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return map_or_for_each(a, n, true, "vector-map"); });
-  define_primitive("vector-for-each", 2, kVariadic,
+  define_primitive("vector-for-each", 2, kVariadic, Stage::Pure,
                    [](Value *a, int n) { return map_or_for_each(a, n, false, "vector-for-each"); });
   // (make-initialized-vector n proc): element i is (proc i).
-  define_primitive("make-initialized-vector", 2, 2, [](Value *a, int) {
+  define_primitive("make-initialized-vector", 2, 2, Stage::Pure, [](Value *a, int) {
     size_t len = arg_size(a, 0, "make-initialized-vector");
     Value out = make_vector(len, Value::boolean(false));
     for (size_t i = 0; i < len; ++i) {
@@ -223,7 +223,7 @@ void install_higher_order() {
   });
   // (vector-binary-search v key key-compare): v is sorted, (key-compare key
   // element) is negative, zero or positive; the matching element or #f.
-  define_primitive("vector-binary-search", 3, 3, [](Value *a, int) {
+  define_primitive("vector-binary-search", 3, 3, Stage::Pure, [](Value *a, int) {
     arg_vector(a, 0, "vector-binary-search");
     size_t low = 0, high = a[0].vector()->len; // search [low, high)
     while (low < high) {

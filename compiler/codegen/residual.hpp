@@ -132,6 +132,11 @@ struct RFunction {
   std::vector<ExprId> outputs;
   std::vector<RStmt> body;
   SrcLoc loc;
+  // A kernel as sicm run compiles one (a system derivative, its Jacobian or
+  // singular factors: one DAG, no statements): its outputs are plain C, as
+  // in the JIT's kernels, and a division by zero is the integrator's
+  // non-finite derivative, reported with the time and state, in both modes.
+  bool kernel = false;
 };
 
 // A global variable that a procedure run at run time assigns with set!: a C

@@ -805,7 +805,10 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       std::vector<std::string> targets;
       for (size_t j = 0; j < fn.outputs.size(); ++j)
         targets.push_back("out[" + std::to_string(j) + "]");
-      code += checked_assignments(fn.outputs, targets, "o", fn.loc);
+      code += fn.kernel && fn.body.empty()
+                  ? emit_c_assignments(
+                        fn.outputs, targets, [this](Symbol *s) { return spell(s); }, "o", "")
+                  : checked_assignments(fn.outputs, targets, "o", fn.loc);
     }
     return code + "}\n\n";
   }

@@ -720,12 +720,15 @@ Value call_original(const char *name, Value *a, int n) {
 
 void rebind(const char *name, int min, int max, PrimFn fn) {
   Symbol *s = intern(name).symbol();
-  if (s->bound && s->global.is(Tag::Primitive))
+  Stage stage = Stage::Pure;
+  if (s->bound && s->global.is(Tag::Primitive)) {
     g_build->original_fns[name] = s->global.as<Primitive>()->fn;
+    stage = s->global.as<Primitive>()->stage; // the build's version does the same kind of work
+  }
   g_build->rebound.push_back(s);
   g_build->rebound_values.push_back(s->global);
   g_build->rebound_bound.push_back(s->bound);
-  define_primitive(name, min, max, fn);
+  define_primitive(name, min, max, stage, fn);
 }
 
 } // namespace sicm::build

@@ -17,6 +17,7 @@
 #include "base/limits.hpp"
 #include "base/number.hpp"
 #include "base/primitive.hpp"
+#include "builtins/numeric_arguments.hpp"
 #include "builtins/numerics_defaults.hpp"
 #include "codegen/emit_taylor.hpp"
 #include "codegen/kernel_form.hpp"
@@ -304,8 +305,15 @@ ExprId limit_expr(Value v, const char *who) {
   return expr_of(v, who);
 }
 
+// Every primitive here first checks its arguments as sicm run's does
+// (builtins/numeric_arguments.hpp), with the same messages.
+void check_arguments(const char *who, Value *a, int n, NativeProc *self = nullptr) {
+  check_numeric_arguments(numeric_signature(who), a, n, self);
+}
+
 Value P_definite_integral(Value *a, int n) {
   static const char who[] = "definite-integral";
+  check_arguments(who, a, n);
   if (is_number(a[1]) && is_number(a[2]) && to_double(a[1]) == to_double(a[2]))
     return Value::fixnum(0); // as the interpreter: an exact 0 over an empty interval
   RStmt s{RKind::Integral};
@@ -320,6 +328,7 @@ Value P_definite_integral(Value *a, int n) {
 }
 
 template <const char *Name> Value P_minimize(Value *a, int n) {
+  check_arguments(Name, a, n);
   RStmt s{RKind::Minimize};
   s.loc = here();
   s.args = {expr_of(a[1], Name), expr_of(a[2], Name)};
@@ -335,17 +344,15 @@ constexpr char kBrentMin[] = "brent-min";
 
 Value P_multidimensional_minimize(Value *a, int n) {
   static const char who[] = "multidimensional-minimize";
-  if (!is_procedure(a[0])) wrong_type(a[0], 1, who);
+  check_arguments(who, a, n);
   bool is_list = !a[1].is(Tag::Vector);
   gcvec<Value> start;
   if (is_list) {
-    if (list_length(a[1]) <= 0) wrong_type(a[1], 2, who);
     start = list_to_vector(a[1]);
   } else {
     Vector *v = a[1].vector();
     start.assign(v->items, v->items + v->len);
   }
-  if (start.empty()) wrong_type(a[1], 2, who);
   RStmt s{RKind::Multimin};
   s.loc = here();
   for (Value x : start)
@@ -387,6 +394,7 @@ Value P_multidimensional_minimize(Value *a, int n) {
 
 Value P_find_root(Value *a, int n) {
   static const char who[] = "find-root";
+  check_arguments(who, a, n);
   RStmt s{RKind::FindRoot};
   s.loc = here();
   s.args = {expr_of(a[1], who), expr_of(a[2], who)};
@@ -400,6 +408,7 @@ Value P_find_root(Value *a, int n) {
 
 Value bisect_at_run_time(Value *a, int n) {
   static const char who[] = "bisect";
+  check_arguments(who, a, n);
   RStmt s{RKind::Bisect};
   s.loc = here();
   s.args = {expr_of(a[1], who), expr_of(a[2], who), expr_of(a[3], who)};
@@ -469,7 +478,7 @@ std::string method_of(Value *a, int n, int i, const char *who) {
     if (!why.empty()) runtime_error(here(), std::string(who) + ": " + why);
     if (i < n) bad_range(a[i], i + 1, who);
     runtime_error(here(), std::string(who) + ": *ode-integration-method* is " + write_string(m) +
-                              ", which names no integrator");
+                              ", which names no integrator (" + integrator_list() + ")");
   }
   return c;
 }
@@ -500,6 +509,33 @@ std::vector<ExprId> system_outputs(const gcvec<Value> &leaves, const char *who) 
   return outputs;
 }
 
+// Every function opens with reads of the cells that set! made (read_cells,
+// pe/build_mode.cpp); a system derivative that uses none of them, beside a
+// monitor that counts with set!, is still one DAG of its state: the reads
+// are dropped, so that it is a kernel, as in sicm run, and has Taylor
+// coefficients.
+void drop_unused_cell_reads(RFunction &f) {
+  std::unordered_set<Symbol *> used;
+  std::vector<ExprId> stack(f.outputs.begin(), f.outputs.end());
+  std::unordered_set<ExprId> seen;
+  while (!stack.empty()) {
+    ExprId id = stack.back();
+    stack.pop_back();
+    if (!seen.insert(id).second) continue;
+    const ExprNode &n = expr_node(id);
+    if (n.kind == ExprKind::Symbol) used.insert(n.sym);
+    if (n.kind == ExprKind::Apply || n.kind == ExprKind::Call) {
+      const ExprId *args = expr_args(id);
+      stack.insert(stack.end(), args, args + n.nargs);
+    }
+  }
+  for (const RStmt &s : f.body)
+    if (s.kind != RKind::Let || s.compute != RCompute::ReadCell ||
+        used.count(g_build->program.vars[s.var].sym))
+      return;
+  f.body.clear();
+}
+
 } // namespace
 
 // A system derivative traced into a new function of the state's leaves
@@ -519,6 +555,8 @@ int trace_system_function(Value sysder, Value state, const char *who) {
                                describe(state));
   std::vector<ExprId> outputs = system_outputs(leaves, who);
   current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
+  drop_unused_cell_reads(current());
+  current().kernel = current().body.empty();
   return scope.id();
 }
 
@@ -586,6 +624,7 @@ void trace_singular_factors(Value state, RStmt &s) {
   for (int v : current().inputs)
     to.push_back(g_build->program.vars[v].sym);
   current().outputs = with_inputs(factors.values, from, to);
+  current().kernel = true;
   s.probe = scope.id();
   s.probe_texts = std::move(factors.texts);
 }
@@ -610,6 +649,8 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
     if (leaves.size() != n * n) return;
     std::vector<ExprId> outputs = system_outputs(leaves, "jacobian");
     current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
+    drop_unused_cell_reads(current());
+    current().kernel = current().body.empty();
     s.jacobian = scope.id();
   } catch (const Error &) {
     parameters.rollback();
@@ -651,7 +692,7 @@ Value sysder_of(Value *a, int n, const char *who) {
 
 Value advance(NativeProc *self, Value *a, int n) {
   static const char who[] = "state-advancer";
-  if (n < 2 || n > 4) native_arity_error(self, n, 2);
+  check_arguments(who, a, n, self);
   RStmt s{RKind::Advance};
   s.loc = here();
   s.number = static_number(a, n, 2, kAdvancerTolerance, who);
@@ -674,7 +715,7 @@ Value P_state_advancer(Value *a, int n) {
 
 Value run_evolve(NativeProc *self, Value *a, int n) {
   static const char who[] = "evolve";
-  if (n < 4 || n > 6) native_arity_error(self, n, 4);
+  check_arguments(who, a, n, self);
   RStmt s{RKind::Evolve};
   s.loc = here();
   s.number = static_number(a, n, 4, kAdvancerTolerance, who);
@@ -686,8 +727,11 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   check_taylor(s, who);
   trace_singular_factors(a[0], s);
   trace_jacobian(self->a, a[0], s);
+  // The first call of the monitor is the program's, on the state as it
+  // is here (exact numbers print as exact, as in sicm run); the runtime
+  // calls the traced monitor at the times of the schedule after it.
   Value monitor = a[1];
-  if (!is_procedure(monitor)) wrong_type(monitor, 2, who);
+  apply_procedure(monitor, &a[0], 1);
   {
     FunctionScope scope(procedure_name(monitor));
     Value x = input_like(a[0]);

@@ -146,4 +146,21 @@ const std::vector<const char *> &effects_refused_for_run() {
   return names;
 }
 
+const std::vector<const char *> &effects_done_while_compiling() {
+  static const std::vector<const char *> names = {
+      // Text known while compiling is the program's output, in its place.
+      "newline", "fresh-line", "write-char", "write-string", "flush-output", "series:print",
+      "series:for-each", "show-expression",
+      // An error raised while compiling is the compiler's to report, as
+      // sicm run reports it (tests/run accepts the same exit status).
+      "error", "warn",
+      // Mutations of lists the compiler holds (run-time lists are refused
+      // by pe/lists.cpp's rows above).
+      "reverse!", "except-last-pair!", "delete!", "sort!",
+      // Which effects a scene asks for: the compiler's own bookkeeping
+      // (builtins/effects_used.cpp, --report).
+      "%use-effect"};
+  return names;
+}
+
 } // namespace sicm::build

@@ -27,6 +27,13 @@ const std::vector<Specialization> &specializations();
 // compile time, instead of at each call.
 const std::vector<const char *> &effects_refused_for_run();
 
+// The effects sicm build performs while compiling, as sicm run would at
+// that point of the program: text known at compile time printed into the
+// program's output, errors raised (the compiler reports them), and
+// mutations of data the compiler holds. Inside a procedure traced for run
+// time they are refused (eval/effect_guard.hpp, effects_refused_for_run).
+const std::vector<const char *> &effects_done_while_compiling();
+
 // ---- pe/build_mode.cpp: printing, tests and rounding of run-time values -----------------
 extern const PrimFn p_display, p_write, p_write_line, p_pp, p_print_expression, p_pe;
 extern const PrimFn p_less, p_greater, p_less_eq, p_greater_eq, p_num_equal;

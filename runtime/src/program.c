@@ -168,7 +168,7 @@ static char *failure_text(const sicm_site *site, const char *who, const char *re
   else
     fprintf(f, "%s: error: %s\n", site->where, reason);
   if (site->line && site->line[0]) {
-    fprintf(f, "  %s\n  ", site->line);
+    fprintf(f, "    %s\n    ", site->line); /* as the compiler's messages (base/error.cpp) */
     for (int i = 1; i < site->col; ++i)
       fputc(site->line[i - 1] == '\t' ? '\t' : ' ', f);
     fputs("^\n", f);
@@ -554,19 +554,16 @@ void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_cl
                        double *y, double dt, double t_final) {
   static const char who[] = "evolve";
   const double t0 = start_time(ode, y);
-  if (dt == 0 && t_final != t0) sicm_program_fail(site, who, "the step between monitor calls is 0");
-  const double step = fabs(dt) * (t_final >= t0 ? 1.0 : -1.0);
-  const double near_end = 1e-9 * fabs(step);
+  sicm_monitor_schedule schedule;
+  const char *why_not = sicm_monitor_schedule_start(&schedule, t0, dt, t_final);
+  if (why_not) sicm_program_fail(site, who, why_not);
   double *shown = malloc(ode->dim * sizeof *shown);
   if (!shown) sicm_program_fail(site, who, "out of memory");
-  if (monitor.fn) monitor.fn(y, NULL, monitor.p);
   integrator it;
   open_integrator(site, who, ode, &it);
   sicm_ode_set_horizon(it.o, t_final);
-  double t = t0;
-  for (long k = 1; fabs(t_final - t) > 0; ++k) {
-    double tk = t0 + (double)k * step;
-    if ((step > 0 ? t_final - tk : tk - t_final) <= near_end) tk = t_final;
+  double t = t0, tk;
+  while (sicm_monitor_schedule_next(&schedule, t, &tk)) {
     evolve_to(site, who, &it, &t, tk, y);
     if (monitor.fn) {
       memcpy(shown, y, ode->dim * sizeof *shown);

@@ -272,6 +272,24 @@ int sicm_ode_set_taylor_extended(sicm_ode *o, sicm_ode_taylor_extended_coefficie
  * t_end, not to the end of the current call. */
 void sicm_ode_set_horizon(sicm_ode *o, double t_end);
 
+/* ---- the monitor schedule of evolve -----------------------------------
+ * evolve calls its monitor at the initial state and then every |dt| towards
+ * t_final, the last interval shortened to end exactly there. Both sicm run
+ * and built programs walk these times, so both stop at the same bits.
+ *
+ * sicm_monitor_schedule_start fills s for an integration from t0; it
+ * returns NULL, or the reason these arguments make no schedule (a step of
+ * 0 towards another time). sicm_monitor_schedule_next stores in *tk the
+ * next time after t (the time the integration has reached) and returns 1,
+ * or returns 0 once t is t_final. */
+typedef struct {
+  double t0, step, t_final, near_end;
+  long k;
+} sicm_monitor_schedule;
+const char *sicm_monitor_schedule_start(sicm_monitor_schedule *s, double t0, double dt,
+                                        double t_final);
+int sicm_monitor_schedule_next(sicm_monitor_schedule *s, double t, double *tk);
+
 /* sicm_ode_reset makes the next sicm_ode_evolve start afresh: the step size is
  * chosen again and multistep history is discarded. Statistics are kept. */
 void sicm_ode_reset(sicm_ode *o);
