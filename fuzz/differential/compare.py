@@ -44,7 +44,10 @@ def run_process(argv: list[str], cwd: str, limit: float, env: dict[str, str],
         out, err = p.communicate(timeout=limit)
         status = p.returncode
     except subprocess.TimeoutExpired:
-        os.killpg(p.pid, signal.SIGKILL)
+        try:
+            os.killpg(p.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
         out, err = p.communicate()
         status = None
     return Side(status, out, err, files_written(cwd) if collect_files else {})
@@ -93,16 +96,19 @@ def normalize_stderr(err: bytes) -> bytes:
     return b"\n".join(out)
 
 
-def differences(run: Side, built: Side) -> list[str]:
-    """What differs between the two sides, in the order a reader wants it."""
+def differences(run: Side, built: Side, hide: bytes = b"") -> list[str]:
+    """What differs between the two sides, in the order a reader wants it.
+    hide: a prefix (the program's directory) left out where text is shown."""
     found = []
     if run.status != built.status:
         found.append(f"exit status: run {run.status}, built {built.status}")
     if run.stdout != built.stdout:
         found.append("stdout" + first_difference(run.stdout, built.stdout))
-    if normalize_stderr(run.stderr) != normalize_stderr(built.stderr):
-        found.append("stderr" + first_difference(normalize_stderr(run.stderr),
-                                                 normalize_stderr(built.stderr)))
+    run_err, built_err = normalize_stderr(run.stderr), normalize_stderr(built.stderr)
+    if run_err != built_err:
+        if hide:
+            run_err, built_err = run_err.replace(hide, b""), built_err.replace(hide, b"")
+        found.append("stderr" + first_difference(run_err, built_err))
     names = differing_files(run.files, built.files)
     if names:
         found.append("files " + ", ".join(names))
@@ -125,6 +131,7 @@ def first_difference(a: bytes, b: bytes) -> str:
 def compare(sicm: str, program_path: str, workdir: str, limit: float,
             env: dict[str, str]) -> Outcome:
     """Run program_path both ways inside workdir (which must be empty)."""
+    hide = (os.path.dirname(program_path) + os.sep).encode()
     run_dir, built_dir = os.path.join(workdir, "run"), os.path.join(workdir, "built")
     os.makedirs(run_dir)
     os.makedirs(built_dir)
@@ -147,7 +154,7 @@ def compare(sicm: str, program_path: str, workdir: str, limit: float,
             return Outcome("build-refused", "sicm build refuses a program sicm run runs: " +
                            first_line(build.stderr), run, None, build.stderr)
         as_built = Side(build.status, b"", build.stderr, {})
-        found = [d for d in differences(run, as_built) if not d.startswith(("stdout", "files"))]
+        found = [d for d in differences(run, as_built, hide) if not d.startswith(("stdout", "files"))]
         if found:
             return Outcome("difference", "at compile time: " + "; ".join(found), run,
                            as_built, build.stderr)
@@ -156,7 +163,7 @@ def compare(sicm: str, program_path: str, workdir: str, limit: float,
     if built.status is None:
         return Outcome("timeout", f"the executable timed out after {limit:g} s", run, built,
                        build.stderr)
-    found = differences(run, built)
+    found = differences(run, built, hide)
     if found:
         return Outcome("difference", "; ".join(found), run, built, build.stderr)
     return Outcome("same", "", run, built, build.stderr)

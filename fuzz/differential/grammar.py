@@ -101,6 +101,14 @@ class Generator:
             self.feature("exact-number")
         return n
 
+    def state_number(self) -> str:
+        """A component of an initial state: exact ones are a feature of
+        their own, since a monitor sees the initial state as given."""
+        if self.allowed("exact-initial-state") and self.chance(0.25):
+            self.feature("exact-initial-state")
+            return self.pick(EXACT_NUMBERS)
+        return self.pick(INEXACT_NUMBERS)
+
     def expression(self, variables: list[str], depth: int, bounded: bool = False) -> str:
         """An expression in the variables. bounded: every value it takes stays
         within a fixed range whatever the variables (sin and cos at the top,
@@ -186,7 +194,7 @@ class Generator:
         m = self.coefficient(params, positive=True)
         k = self.coefficient(params, positive=True)
         c = self.coefficient(params)
-        init = f"(up 0. {self.number()} {self.number()})"
+        init = f"(up 0. {self.state_number()} {self.state_number()})"
         return System(definition, f"Lagrangian->state-derivative (L {m} {k} {c})", init, 1,
                       separable, f"Lagrangian->state-derivative (L {m} {k} {{c}})")
 
@@ -201,7 +209,7 @@ class Generator:
         m = self.coefficient(params, positive=True)
         k = self.coefficient(params, positive=True)
         c = self.coefficient(params)
-        init = f"(up 0. (up {self.number()} {self.number()}) (up {self.number()} 0.))"
+        init = f"(up 0. (up {self.state_number()} {self.state_number()}) (up {self.state_number()} 0.))"
         return System(definition, f"Lagrangian->state-derivative (L2 {m} {k} {c})", init, 2,
                       True, f"Lagrangian->state-derivative (L2 {m} {k} {{c}})")
 
@@ -217,7 +225,7 @@ class Generator:
             f"    (up 1 v (- (* b {force}) (* a x){damping}))))\n")
         a = self.coefficient(params, positive=True)
         b = self.coefficient(params)
-        init = f"(up 0. {self.number()} {self.number()})"
+        init = f"(up 0. {self.state_number()} {self.state_number()})"
         return System(definition, f"sysder {a} {b}", init, 1, False, f"sysder {a} {{c}}")
 
     # --- monitors ---------------------------------------------------------------
@@ -365,17 +373,24 @@ class Generator:
 
     def find_root(self, params: list[str]) -> str:
         self.feature("find-root")
-        # x - c g(x) with |c g| < 1 changes sign on [-2, 2].
-        g = self.expression(["x"], 2, bounded=True)
-        c = self.pick([".5", ".3", "-.7", "1/2"])
-        return f"(find-root (lambda (x) (- x (* {c} {g}))) -2. 2.)\n"
+        return f"(find-root {self.root_function()} -2. 2.)\n"
 
     def bisect(self, params: list[str]) -> str:
         self.feature("bisect")
-        g = self.expression(["x"], 2, bounded=True)
-        c = self.pick([".5", ".3", "-.7"])
         eps = self.pick(["1e-10", "1e-6", ".001"])
-        return f"(bisect (lambda (x) (- x (* {c} {g}))) -2. 2. {eps})\n"
+        return f"(bisect {self.root_function()} -2. 2. {eps})\n"
+
+    def root_function(self) -> str:
+        """x - d - c g(x) with |c g| < 1 and |d| < 1: a sign change on [-2, 2].
+        Without d the root is often exactly 0, which find-root misses in
+        both modes ("no convergence"): a feature of its own."""
+        g = self.expression(["x"], 2, bounded=True)
+        c = self.pick([".5", ".3", "-.7", "1/2"])
+        if self.allowed("root-at-zero") and self.chance(0.1):
+            self.feature("root-at-zero")
+            return f"(lambda (x) (- x (* {c} (sin x))))"
+        d = self.pick([".1", "-.25", ".37", "1/3"])
+        return f"(lambda (x) (- x {d} (* {c} {g})))"
 
     def orbit_plot(self, params: list[str]) -> str:
         self.feature("plot-orbit")
