@@ -11,6 +11,8 @@
 #                   docs/accuracy.md
 #   make examples   build every figure scene at full size with sicm build,
 #                   run it, and write its plot into build/figures
+#   make fuzz-differential  random programs run and built, compared byte for
+#                   byte (SEED=1 COUNT=500 JOBS=1; fuzz/README.md)
 #   make install    install sicm under $(PREFIX)
 #   make clean
 #
@@ -68,7 +70,7 @@ UNITBIN := $(BUILD)/unit-tests
 MPILIB  := $(if $(MPICC),$(BUILD)/libsicmrt_mpi.a)
 MPI_OBJS := $(if $(MPICC),$(BUILD)/runtime/mpi/parallel_mpi.o)
 
-.PHONY: all check demo examples stability accuracy effects install clean deps unit fuzz-smoke
+.PHONY: all check demo examples stability accuracy effects install clean deps unit fuzz-smoke fuzz-differential
 all: $(SICM) $(RTLIB) $(MPILIB)
 
 $(BUILD)/%.o: %.cpp
@@ -149,7 +151,7 @@ FUZZ ?= 1
 check: deps
 	@$(MAKE) --no-print-directory all $(UNITBIN)
 	@$(SANENV) python3 tests/run --sicm $(SICM) --unit $(UNITBIN) $(if $(UPDATE),--update) \
-	  $(if $(filter 1,$(FUZZ)),--fuzz scripts/fuzz)
+	  --differential scripts/fuzz-differential $(if $(filter 1,$(FUZZ)),--fuzz scripts/fuzz)
 
 demo: deps
 	@$(MAKE) --no-print-directory all
@@ -185,6 +187,15 @@ examples: deps
 fuzz-smoke: deps
 	@$(MAKE) --no-print-directory all
 	@scripts/fuzz smoke
+
+# Random mechanics programs run with sicm run and built with sicm build,
+# compared byte for byte (fuzz/README.md): SEED, COUNT programs, JOBS at once.
+SEED ?= 1
+COUNT ?= 500
+JOBS ?= 1
+fuzz-differential: deps
+	@$(MAKE) --no-print-directory all
+	@scripts/fuzz-differential --sicm $(SICM) --seed $(SEED) --count $(COUNT) --jobs $(JOBS)
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/sicm
