@@ -106,6 +106,8 @@ struct RStmt {
   int plot = -1;            // plot statements: the plot's number
   int callee = -1;          // the function a numerical statement calls
   int monitor = -1;         // Evolve: the monitor function, or -1
+  int first_monitor = -1;   // Evolve: the monitor for the initial state as written (exact
+                            // numbers), or -1: monitor
   std::vector<int> members; // ParallelMap: the members' functions (one for all, or one each)
   int count = 0;            // ParallelMap: the number of members
   int jacobian = -1;        // Advance, Evolve: (D sysder) for implicit methods

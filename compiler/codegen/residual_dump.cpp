@@ -129,6 +129,7 @@ private:
     };
     add("calls", s.callee);
     add("monitor", s.monitor);
+    add("first-monitor", s.first_monitor);
     add("jacobian", s.jacobian);
     add("probe", s.probe);
     for (int m : s.members)

@@ -287,7 +287,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       if (s.kind == RKind::Print) needs.insert(s.var);
       for (ExprId a : s.args)
         refs_of(a, &s, needs);
-      for (int callee : {s.callee, s.monitor, s.jacobian, s.probe})
+      for (int callee : {s.callee, s.monitor, s.first_monitor, s.jacobian, s.probe})
         if (callee >= 0) needs.insert(captures_[callee].begin(), captures_[callee].end());
       for (int member : s.members)
         needs.insert(captures_[member].begin(), captures_[member].end());
@@ -628,6 +628,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
                 a[dim] + ");\n";
       else
         code += "sicm_drive_evolve(" + site(s.loc) + ", &" + ode(s, dim) + ", " +
+                closure(s.first_monitor >= 0 ? s.first_monitor : s.monitor) + ", " +
                 closure(s.monitor) + ", " + y + ", " + a[dim] + ", " + a[dim + 1] + ");\n";
       code += unpack(f, s.outs, y);
       break;

@@ -274,7 +274,7 @@ void emit(RStmt s) {
   if (!body.empty() && body.back().kind == RKind::Continue) throw_not_a_loop();
   note_residual_statement(s.loc); // --max-residual-size
   if (s.kind != RKind::Text) ++g_build->work;
-  bool calls = s.callee >= 0 || s.monitor >= 0;
+  bool calls = s.callee >= 0 || s.monitor >= 0 || s.first_monitor >= 0;
   body.push_back(std::move(s));
   if (calls) read_cells(); // the call may have assigned them
 }

@@ -662,6 +662,14 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
   }
 }
 
+bool has_exact_leaf(Value state) {
+  gcvec<Value> leaves;
+  state_leaves(state, leaves);
+  for (Value leaf : leaves)
+    if (is_number(leaf) && is_exact(leaf)) return true;
+  return false;
+}
+
 Value state_result(Value state, RStmt &s) {
   gcvec<Value> leaves;
   state_leaves(state, leaves);
@@ -727,16 +735,22 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   check_taylor(s, who);
   trace_singular_factors(a[0], s);
   trace_jacobian(self->a, a[0], s);
-  // The first call of the monitor is the program's, on the state as it
-  // is here (exact numbers print as exact, as in sicm run); the runtime
-  // calls the traced monitor at the times of the schedule after it.
   Value monitor = a[1];
-  apply_procedure(monitor, &a[0], 1);
   {
     FunctionScope scope(procedure_name(monitor));
     Value x = input_like(a[0]);
     apply_procedure(monitor, &x, 1);
     s.monitor = scope.id();
+  }
+  // sicm run gives the monitor's first call the state as the program wrote
+  // it: where that holds exact numbers (a time of 0), which print as exact,
+  // the first call is the monitor traced on that state itself.
+  if (has_exact_leaf(a[0])) {
+    FunctionScope scope(procedure_name(monitor));
+    input_like(a[0]); // the function's inputs, as every monitor's: the state
+    Value x = a[0];
+    apply_procedure(monitor, &x, 1);
+    s.first_monitor = scope.id();
   }
   Value r = state_result(a[0], s);
   emit(std::move(s));

@@ -4,14 +4,15 @@ makes of it, and say how the two differ.
 Each side runs in an empty directory of its own (the program is given by
 absolute path, so diagnostics name the same file), under a time limit that
 kills the whole process group. Compared: stdout bytes, the exit status, the
-bytes of every file written (plots), and stderr after normalize_stderr.
+bytes of every file written (plots), and stderr: the same bytes too (a
+failure of the executable is laid out as the compiler lays out its
+diagnostics: runtime/src/program.c).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import os
-import re
 import signal
 import subprocess
 
@@ -68,34 +69,6 @@ def differing_files(a: dict[str, bytes], b: dict[str, bytes]) -> list[str]:
     return sorted(set(a) ^ set(b)) or sorted(n for n in a if a[n] != b[n])
 
 
-DIAGNOSTIC = re.compile(rb"^(?P<where>.+?:\d+:(?P<col>\d+)): error: ")
-
-
-def normalize_stderr(err: bytes) -> bytes:
-    """stderr with the one difference the modes are allowed: the indentation
-    of the source line and caret under a diagnostic (sicm run indents them
-    by four spaces, the executable by two). The indentation is measured on
-    the caret line against the diagnostic's column and removed from both
-    lines; everything else, the message and its location included, must be
-    the same bytes."""
-    lines = err.split(b"\n")
-    out = []
-    i = 0
-    while i < len(lines):
-        line = lines[i]
-        out.append(line)
-        m = DIAGNOSTIC.match(line)
-        if m and i + 2 < len(lines) and lines[i + 2].rstrip().endswith(b"^"):
-            source, caret = lines[i + 1], lines[i + 2]
-            indent = caret.index(b"^") - (int(m.group("col")) - 1)
-            if indent >= 0 and source[:indent].strip() == b"" and caret[:indent].strip() == b"":
-                out += [source[indent:], caret[indent:]]
-                i += 3
-                continue
-        i += 1
-    return b"\n".join(out)
-
-
 def differences(run: Side, built: Side, hide: bytes = b"") -> list[str]:
     """What differs between the two sides, in the order a reader wants it.
     hide: a prefix (the program's directory) left out where text is shown."""
@@ -104,7 +77,7 @@ def differences(run: Side, built: Side, hide: bytes = b"") -> list[str]:
         found.append(f"exit status: run {run.status}, built {built.status}")
     if run.stdout != built.stdout:
         found.append("stdout" + first_difference(run.stdout, built.stdout))
-    run_err, built_err = normalize_stderr(run.stderr), normalize_stderr(built.stderr)
+    run_err, built_err = run.stderr, built.stderr
     if run_err != built_err:
         if hide:
             run_err, built_err = run_err.replace(hide, b""), built_err.replace(hide, b"")

@@ -550,10 +550,12 @@ void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double
   close_integrator(&it);
 }
 
-void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure monitor,
+void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure first,
+                       sicm_closure monitor,
                        double *y, double dt, double t_final) {
   static const char who[] = "evolve";
   const double t0 = start_time(ode, y);
+  if (first.fn) first.fn(y, NULL, first.p);
   sicm_monitor_schedule schedule;
   const char *why_not = sicm_monitor_schedule_start(&schedule, t0, dt, t_final);
   if (why_not) sicm_program_fail(site, who, why_not);

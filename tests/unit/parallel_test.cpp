@@ -257,14 +257,16 @@ void run_serial_failing_sweep(const std::string &stdout_path) {
 } // namespace
 
 TEST(ParallelMapDeathTest, FailingMemberStopsTheSweep) {
+  // The source line under the message is indented by four spaces, as the
+  // compiler indents its diagnostics (base/error.cpp).
   // The pool's threads are started here first: the child of the death
   // test's fork has none of them, and must start its own.
   EXPECT_EQ(run_printers(4, 8), "0:0. 1:.25 2:1. 3:2.25 4:4. 5:6.25 6:9. 7:12.25 ");
   const std::string out = temp_dir() + "/stdout";
   EXPECT_EXIT(run_failing_sweep(out), ::testing::ExitedWithCode(70),
               "^members\\.sicm:7:5: error: find-root: the interval does not bracket a root\n"
-              " {4}\\(if \\(= i 5\\) \\(error-at i\\)\\)\n"
-              " {6}\\^\n$");
+              " {6}\\(if \\(= i 5\\) \\(error-at i\\)\\)\n"
+              " {8}\\^\n$");
   EXPECT_EQ(slurp(out), "0 1 2 3 4 5 ");
 }
 

@@ -168,13 +168,15 @@ typedef struct {
  * later. */
 void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double *y, double dt);
 
-/* ((evolve ...) state monitor dt t-final tol): calls monitor (a kernel of
- * the state, NULL fn for none) every dt until t-final (the last interval
- * shortened to end there: sicm_monitor_schedule); y becomes the final
- * state. The call of the monitor at the initial state is the program's
- * own (sicm build emits it before this one, on the state as the program
- * wrote it, exact numbers and all, as sicm run makes it). */
-void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure monitor,
+/* ((evolve ...) state monitor dt t-final tol): calls first (a kernel of
+ * the state, NULL fn for none) at the initial state, then monitor every dt
+ * until t-final (the last interval shortened to end there:
+ * sicm_monitor_schedule); y becomes the final state. first is monitor
+ * itself, or, when the program wrote the initial state with exact numbers,
+ * the monitor compiled for that state (so they print as exact, as in sicm
+ * run). */
+void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure first,
+                       sicm_closure monitor,
                        double *y, double dt, double t_final);
 
 /* ---- parallel-map and parallel-for-each (parallel.c) ----
