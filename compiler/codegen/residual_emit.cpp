@@ -208,7 +208,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       case ExprKind::Symbol: {
         int v = var_id(n.sym);
         if (v < 0)
-          throw Error(ErrorKind::Syntax, where ? where->loc : SrcLoc{},
+          throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, where ? where->loc : SrcLoc{},
                       "cannot compile: a numerical result depends on the symbol " + n.sym->name +
                           ", which has no numeric value",
                       "give it a number, or use `sicm run` for symbolic results");
@@ -217,7 +217,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       }
       case ExprKind::Call:
         if (!is_solve_node(id))
-          throw Error(ErrorKind::Syntax, where ? where->loc : SrcLoc{},
+          throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, where ? where->loc : SrcLoc{},
                       "cannot compile: a numerical result applies the unknown function " +
                           expr_debug_string(n.head),
                       "a literal function has no numeric value at run time");
@@ -329,7 +329,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
 
   [[noreturn]] void escape_error(const RVar &v) {
     const RFunction &owner = p_.functions[v.function];
-    throw Error(ErrorKind::Syntax, owner.loc,
+    throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, owner.loc,
                 "cannot compile: a value computed inside the procedure " + owner.name +
                     " (which runs at run time, called by the numerical primitive here) is used "
                     "outside it",

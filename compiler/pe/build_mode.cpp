@@ -85,7 +85,7 @@ const char kMarkerSuffix[] = "__";
 } // namespace
 
 [[noreturn]] void cannot_compile(SrcLoc loc, const std::string &what) {
-  throw Error(ErrorKind::Syntax, loc, "cannot compile: " + what,
+  throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, loc, "cannot compile: " + what,
               "sicm build leaves only numerical work for run time; `sicm run` interprets this "
               "program");
 }
@@ -361,7 +361,7 @@ Value with_retrace(const std::function<Value()> &body) {
 }
 
 bool is_cannot_compile(const Error &e) {
-  return e.kind == ErrorKind::Syntax && std::string_view(e.what()).starts_with("cannot compile: ");
+  return e.cause == ErrorCause::CannotCompile;
 }
 
 Value let(RCompute c, std::vector<ExprId> args, RType type) {

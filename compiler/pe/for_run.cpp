@@ -187,7 +187,7 @@ CompiledFn compile_traced_for_run(Value proc, const std::function<int()> &trace,
       id = trace();
       program = std::move(build.program());
     } catch (const Error &e) {
-      if (std::string_view(e.what()) == "Interrupted") throw;
+      if (e.cause == ErrorCause::Interrupted) throw;
       *why_not = e.what();
       return nullptr;
     } catch (...) { // an escape from the procedure: it will escape when interpreted, too
