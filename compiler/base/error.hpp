@@ -6,8 +6,11 @@
 //         the source line
 //             ^
 // Broken internal invariants are not Errors: they abort (see SICM_ASSERT).
+// Code that catches an Error to retry, fall back or read on decides by its
+// cause (ErrorCause), never by its message, which is for people.
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -22,16 +25,31 @@ enum class ErrorKind {
   Runtime, // errors while evaluating: exit 70
 };
 
+// What an error means to the code that catches it. Set where the error is
+// raised; the message may be reworded freely.
+enum class ErrorCause : uint8_t {
+  Other,           // an ordinary error of the program
+  CannotCompile,   // sicm build cannot leave this for run time ("cannot compile: ...";
+                   // pe/build_mode.cpp): a caller may try another way
+  Limit,           // a named limit of base/limits.hpp (steps, memory, expression nodes,
+                   // recursion depth, residual size) was hit
+  Interrupted,     // Ctrl-C (base/limits.hpp): nothing may swallow it
+  IncompleteInput, // the reader ran out of text inside a datum: the REPL reads another line
+};
+
 // Exit statuses, following sysexits.h as compilers do.
 constexpr int kExitCompileError = 65; // EX_DATAERR
 constexpr int kExitRuntimeError = 70; // EX_SOFTWARE
 
 struct Error : std::runtime_error {
   ErrorKind kind;
+  ErrorCause cause = ErrorCause::Other;
   SrcLoc loc;
   std::string note; // optional extra line (e.g. "did you mean ...")
   Error(ErrorKind k, SrcLoc l, std::string msg, std::string n = {})
       : std::runtime_error(std::move(msg)), kind(k), loc(l), note(std::move(n)) {}
+  Error(ErrorKind k, ErrorCause c, SrcLoc l, std::string msg, std::string n = {})
+      : std::runtime_error(std::move(msg)), kind(k), cause(c), loc(l), note(std::move(n)) {}
   int exit_code() const {
     return kind == ErrorKind::Syntax ? kExitCompileError : kExitRuntimeError;
   }

@@ -116,8 +116,9 @@ uint64_t g_residual = 0;
 
 // ---- the errors -------------------------------------------------------------------
 
-[[noreturn]] void limit_error(SrcLoc where, const std::string &msg) {
-  throw Error(g_compile_time ? ErrorKind::Syntax : ErrorKind::Runtime, where, msg);
+[[noreturn]] void limit_error(SrcLoc where, const std::string &msg,
+                              ErrorCause cause = ErrorCause::Limit) {
+  throw Error(g_compile_time ? ErrorKind::Syntax : ErrorKind::Runtime, cause, where, msg);
 }
 
 // Where evaluation is, for errors raised outside the evaluator's loop.
@@ -150,7 +151,7 @@ std::string show_bytes(uint64_t n) {
 }
 
 [[noreturn]] void interrupted(SrcLoc where) {
-  limit_error(where, "Interrupted");
+  limit_error(where, "Interrupted", ErrorCause::Interrupted);
 }
 
 // ---- memory -----------------------------------------------------------------------

@@ -47,7 +47,7 @@ RunTimeValueTest g_run_time_value_test = nullptr;
 // time by sicm build.
 void refuse_run_time_argument(Value obj, int argpos, const char *who) {
   if (!g_run_time_value_test || !g_run_time_value_test(obj)) return;
-  throw Error(ErrorKind::Syntax, current_call_loc(),
+  throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, current_call_loc(),
               std::string("cannot compile: ") + who + " of a number known only at run time (its " +
                   ordinal(argpos) + " argument)",
               "sicm build leaves only numerical work for run time; `sicm run` interprets this "

@@ -208,7 +208,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       case ExprKind::Symbol: {
         int v = var_id(n.sym);
         if (v < 0)
-          throw Error(ErrorKind::Syntax, where ? where->loc : SrcLoc{},
+          throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, where ? where->loc : SrcLoc{},
                       "cannot compile: a numerical result depends on the symbol " + n.sym->name +
                           ", which has no numeric value",
                       "give it a number, or use `sicm run` for symbolic results");
@@ -217,7 +217,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       }
       case ExprKind::Call:
         if (!is_solve_node(id))
-          throw Error(ErrorKind::Syntax, where ? where->loc : SrcLoc{},
+          throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, where ? where->loc : SrcLoc{},
                       "cannot compile: a numerical result applies the unknown function " +
                           expr_debug_string(n.head),
                       "a literal function has no numeric value at run time");
@@ -329,7 +329,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
 
   [[noreturn]] void escape_error(const RVar &v) {
     const RFunction &owner = p_.functions[v.function];
-    throw Error(ErrorKind::Syntax, owner.loc,
+    throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, owner.loc,
                 "cannot compile: a value computed inside the procedure " + owner.name +
                     " (which runs at run time, called by the numerical primitive here) is used "
                     "outside it",
@@ -459,200 +459,246 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     return code;
   }
 
+  // One statement's C: each kind is written by its own function below;
+  // If and Loop, which hold blocks, by block(). `prefix` names the
+  // statement's temporaries.
   std::string statement(int f, const RStmt &s) {
     std::string prefix = "s" + std::to_string(nstatements_++) + "_";
-    std::string code;
-    auto args = [&] { return operands(s.args, prefix, s.loc, code); };
     switch (s.kind) {
-    case RKind::Text: code += "sicm_print_text(" + c_string_literal(s.text) + ");\n"; break;
-    case RKind::Print: {
-      RType t = p_.vars[s.var].type;
-      const char *fn = t == RType::Real      ? "sicm_print_real"
-                       : t == RType::Integer ? "sicm_print_integer"
-                                             : "sicm_print_boolean";
-      code += std::string(fn) + "(" + var_name(s.var) + ");\n";
-      break;
-    }
-    case RKind::Let: {
-      std::string v = decl(f, s.var);
-      if (s.compute == RCompute::Expr) {
-        code += checked_assignments(s.args, {v}, prefix + "t", s.loc);
-        break;
-      }
-      if (s.compute == RCompute::Select) {
-        // Only the chosen arm is computed, as the interpreter's if computes
-        // it: the other may divide by zero or leave the reals.
-        std::vector<std::string> test = operands({s.args[0]}, prefix, s.loc, code);
-        if (v != var_name(s.var)) code += v + ";\n";
-        code += "if (" + test[0] + " != 0.0) {\n" +
-                checked_assignments({s.args[1]}, {var_name(s.var)}, prefix + "y", s.loc) +
-                "} else {\n" +
-                checked_assignments({s.args[2]}, {var_name(s.var)}, prefix + "n", s.loc) + "}\n";
-        break;
-      }
-      std::vector<std::string> a = args();
-      std::string e;
-      switch (s.compute) {
-      case RCompute::Expr: break;
-      case RCompute::Less: e = "(" + a[0] + " < " + a[1] + ") ? 1.0 : 0.0"; break;
-      case RCompute::LessEq: e = "(" + a[0] + " <= " + a[1] + ") ? 1.0 : 0.0"; break;
-      case RCompute::Equal: e = "(" + a[0] + " == " + a[1] + ") ? 1.0 : 0.0"; break;
-      case RCompute::Select: break; // above
-      case RCompute::Not: e = a[0] + " == 0.0 ? 1.0 : 0.0"; break;
-      case RCompute::Floor: e = "floor(" + a[0] + ")"; break;
-      case RCompute::Round: e = "nearbyint(" + a[0] + ")"; break;
-      case RCompute::Truncate: e = "trunc(" + a[0] + ")"; break;
-      case RCompute::Max:
-        e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmax(" + a[0] + ", " + a[1] + ")";
-        break;
-      case RCompute::RealTime: e = "sicm_real_time()"; break;
-      case RCompute::ReadCell: e = "cell" + std::to_string(s.cell); break;
-      case RCompute::Param:
-        e = "sicm_program_param(" + c_string_literal(s.text) + ", " + a[0] + ")";
-        break;
-      case RCompute::RunTime: e = "sicm_run_time()"; break;
-      case RCompute::ListLength: e = "sicm_list_length(&list" + std::to_string(s.list) + ")"; break;
-      case RCompute::ListRef:
-        e = "sicm_list_ref(" + site(s.loc) + ", " + c_string_literal(s.text) + ", &list" +
-            std::to_string(s.list) + ", " + a[0] + ", " + a[1] + ", " + a[2] + ", " +
-            std::to_string(s.leaf) + ")";
-        break;
-      case RCompute::ListFold:
-        e = "sicm_list_fold(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
-            kFoldOps[s.leaf] + ", " + a[0] + ", " + a[1] + ", " + (s.backward ? "1" : "0") + ")";
-        break;
-      case RCompute::Min:
-        e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmin(" + a[0] + ", " + a[1] + ")";
-        break;
-      }
-      code += v + " = " + e + ";\n";
-      break;
-    }
-    case RKind::Frame: {
-      std::vector<std::string> a = args();
-      code += "plot" + std::to_string(s.plot) + " = sicm_program_frame(" + site(s.loc) + ", " +
-              c_string_literal(s.text) + ", " +
-              (s.title.empty() ? std::string("NULL") : c_string_literal(s.title)) + ", " + a[0] +
-              ", " + a[1] + ", " + a[2] + ", " + a[3] + ");\n";
-      if (!s.axis_labels.empty())
-        code += "sicm_program_plot_labels(" + site(s.loc) + ", plot" + std::to_string(s.plot) +
-                ", " + c_string_literal(s.axis_labels[0]) + ", " +
-                (s.axis_labels.size() > 1 ? c_string_literal(s.axis_labels[1]) : "NULL") + ");\n";
-      break;
-    }
-    case RKind::PlotPoint: {
-      std::vector<std::string> a = args();
-      code += "sicm_program_plot_point(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
-              a[0] + ", " + a[1] + ");\n";
-      break;
-    }
-    case RKind::PlotLine: {
-      std::vector<std::string> a = args();
-      code += "sicm_program_plot_line(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
-              a[0] + ", " + a[1] + ", " + a[2] + ", " + a[3] + ");\n";
-      break;
-    }
-    case RKind::ListNew:
-      code += "sicm_list_reset(&list" + std::to_string(s.list) + ", " +
-              std::to_string(p_.lists[s.list].width) + ");\n";
-      break;
-    case RKind::ListPush: {
-      std::vector<std::string> a = args();
-      code += "sicm_list_push(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
-              (a.empty() ? std::string("NULL") : "(const double[]){" + join(a) + "}") + ");\n";
-      break;
-    }
-    case RKind::ListConst: {
-      const RTable &t = p_.tables[static_cast<size_t>(s.leaf)];
-      size_t count = t.width ? t.data.size() / static_cast<size_t>(t.width) : 0;
-      code += "sicm_list_assign(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
-              std::to_string(t.width) + ", table" + std::to_string(s.leaf) + ", " +
-              std::to_string(count) + ");\n";
-      break;
-    }
-    case RKind::Close: code += "sicm_plot_finish(plot" + std::to_string(s.plot) + ");\n"; break;
-    case RKind::SetCell: {
-      std::vector<std::string> a = args();
-      code += "cell" + std::to_string(s.cell) + " = " + a[0] + ";\n";
-      break;
-    }
+    case RKind::Text: return "sicm_print_text(" + c_string_literal(s.text) + ");\n";
+    case RKind::Print: return print(s);
+    case RKind::Let: return let(f, s, prefix);
+    case RKind::Frame: return frame(s, prefix);
+    case RKind::PlotPoint: return plot_point(s, prefix);
+    case RKind::PlotLine: return plot_line(s, prefix);
+    case RKind::Close: return "sicm_plot_finish(plot" + std::to_string(s.plot) + ");\n";
+    case RKind::SetCell: return set_cell(s, prefix);
+    case RKind::ListNew: return list_new(s);
+    case RKind::ListPush: return list_push(s, prefix);
+    case RKind::ListConst: return list_const(s);
     case RKind::Integral:
-    case RKind::FindRoot: {
-      std::vector<std::string> a = args();
-      const char *fn = s.kind == RKind::Integral ? "sicm_drive_integral" : "sicm_drive_find_root";
-      std::string call = std::string(fn) + "(" + site(s.loc) + ", " + closure(s.callee) + ", " +
-                         a[0] + ", " + a[1] + ", " + c_double_literal(s.number) + ")";
-      if (used_[f].count(s.outs[0]))
-        code += decl(f, s.outs[0]) + " = " + call + ";\n";
-      else
-        code += "(void)" + call + ";\n";
-      break;
-    }
-    case RKind::Bisect: {
-      std::vector<std::string> a = args();
-      std::string call = "sicm_drive_bisect(" + site(s.loc) + ", " + closure(s.callee) + ", " +
-                         a[0] + ", " + a[1] + ", " + a[2] + ", " +
-                         std::to_string(static_cast<long>(s.number)) + ")";
-      if (used_[f].count(s.outs[0]))
-        code += decl(f, s.outs[0]) + " = " + call + ";\n";
-      else
-        code += "(void)" + call + ";\n";
-      break;
-    }
-    case RKind::Minimize: {
-      std::vector<std::string> a = args();
-      code += "double " + prefix + "out[3];\n";
-      code += "sicm_drive_minimize(" + site(s.loc) + ", " + closure(s.callee) + ", " + a[0] + ", " +
-              a[1] + ", " + c_double_literal(s.number) + ", " + prefix + "out);\n";
-      code += unpack(f, s.outs, prefix + "out");
-      break;
-    }
-    case RKind::Multimin: {
-      std::vector<std::string> a = args();
-      std::string x = prefix + "x";
-      code += "double " + x + "[] = {" + join(a) + "};\n";
-      code += "sicm_drive_multimin(" + site(s.loc) + ", " + closure(s.callee) + ", " +
-              std::to_string(a.size()) + ", " + x + ", " + c_double_literal(s.number) + ");\n";
-      code += unpack(f, s.outs, x);
-      break;
-    }
+    case RKind::FindRoot: return integral_or_root(f, s, prefix);
+    case RKind::Bisect: return bisect(f, s, prefix);
+    case RKind::Minimize: return minimize(f, s, prefix);
+    case RKind::Multimin: return multimin(f, s, prefix);
     case RKind::Advance:
-    case RKind::Evolve: {
-      std::vector<std::string> a = args();
-      size_t extra = s.kind == RKind::Advance ? 1 : 2;
-      size_t dim = a.size() - extra;
-      std::string y = prefix + "y";
-      code += "double " + y + "[] = {" + join({a.begin(), a.begin() + dim}) + "};\n";
-      if (s.kind == RKind::Advance)
-        code += "sicm_drive_advance(" + site(s.loc) + ", &" + ode(s, dim) + ", " + y + ", " +
-                a[dim] + ");\n";
-      else
-        code += "sicm_drive_evolve(" + site(s.loc) + ", &" + ode(s, dim) + ", " +
-                closure(s.first_monitor >= 0 ? s.first_monitor : s.monitor) + ", " +
-                closure(s.monitor) + ", " + y + ", " + a[dim] + ", " + a[dim + 1] + ");\n";
-      code += unpack(f, s.outs, y);
-      break;
+    case RKind::Evolve: return advance_or_evolve(f, s, prefix);
+    case RKind::ParallelMap: {
+      std::string code;
+      std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+      return code + parallel_map(f, s, prefix, a);
     }
-    case RKind::ParallelMap: code += parallel_map(f, s, prefix, args()); break;
+    case RKind::Continue: return loop_exit(s, prefix, s.outs, "continue;\n");
+    case RKind::Break: return loop_exit(s, prefix, s.results, "break;\n");
     case RKind::If:
-    case RKind::Loop: break; // written by block()
-    case RKind::Continue: {
-      std::vector<std::string> a = args(); // all new values first, then assign
-      for (size_t i = 0; i < s.outs.size(); ++i)
-        code += var_name(s.outs[i]) + " = " + a[i] + ";\n";
-      code += "continue;\n";
-      break;
+    case RKind::Loop: // written by block()
+    case RKind::Fail: return "";
     }
-    case RKind::Break: {
-      std::vector<std::string> a = args();
-      for (size_t i = 0; i < s.results.size(); ++i)
-        code += var_name(s.results[i]) + " = " + a[i] + ";\n";
-      code += "break;\n";
-      break;
+    return "";
+  }
+
+  std::string print(const RStmt &s) {
+    RType t = p_.vars[s.var].type;
+    const char *fn = t == RType::Real      ? "sicm_print_real"
+                     : t == RType::Integer ? "sicm_print_integer"
+                                           : "sicm_print_boolean";
+    return std::string(fn) + "(" + var_name(s.var) + ");\n";
+  }
+
+  std::string let(int f, const RStmt &s, const std::string &prefix) {
+    std::string v = decl(f, s.var);
+    if (s.compute == RCompute::Expr) return checked_assignments(s.args, {v}, prefix + "t", s.loc);
+    std::string code;
+    if (s.compute == RCompute::Select) {
+      // Only the chosen arm is computed, as the interpreter's if computes
+      // it: the other may divide by zero or leave the reals.
+      std::vector<std::string> test = operands({s.args[0]}, prefix, s.loc, code);
+      if (v != var_name(s.var)) code += v + ";\n";
+      code += "if (" + test[0] + " != 0.0) {\n" +
+              checked_assignments({s.args[1]}, {var_name(s.var)}, prefix + "y", s.loc) +
+              "} else {\n" +
+              checked_assignments({s.args[2]}, {var_name(s.var)}, prefix + "n", s.loc) + "}\n";
+      return code;
     }
-    case RKind::Fail: break;
-    }
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    std::string e = computed(s, a);
+    code += v + " = " + e + ";\n";
     return code;
+  }
+
+  // The C expression of a Let's computation (not Expr or Select) on its
+  // operands `a`.
+  std::string computed(const RStmt &s, const std::vector<std::string> &a) {
+    std::string e;
+    switch (s.compute) {
+    case RCompute::Expr: break;
+    case RCompute::Less: e = "(" + a[0] + " < " + a[1] + ") ? 1.0 : 0.0"; break;
+    case RCompute::LessEq: e = "(" + a[0] + " <= " + a[1] + ") ? 1.0 : 0.0"; break;
+    case RCompute::Equal: e = "(" + a[0] + " == " + a[1] + ") ? 1.0 : 0.0"; break;
+    case RCompute::Select: break; // let()
+    case RCompute::Not: e = a[0] + " == 0.0 ? 1.0 : 0.0"; break;
+    case RCompute::Floor: e = "floor(" + a[0] + ")"; break;
+    case RCompute::Round: e = "nearbyint(" + a[0] + ")"; break;
+    case RCompute::Truncate: e = "trunc(" + a[0] + ")"; break;
+    case RCompute::Max:
+      e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmax(" + a[0] + ", " + a[1] + ")";
+      break;
+    case RCompute::RealTime: e = "sicm_real_time()"; break;
+    case RCompute::ReadCell: e = "cell" + std::to_string(s.cell); break;
+    case RCompute::Param:
+      e = "sicm_program_param(" + c_string_literal(s.text) + ", " + a[0] + ")";
+      break;
+    case RCompute::RunTime: e = "sicm_run_time()"; break;
+    case RCompute::ListLength: e = "sicm_list_length(&list" + std::to_string(s.list) + ")"; break;
+    case RCompute::ListRef:
+      e = "sicm_list_ref(" + site(s.loc) + ", " + c_string_literal(s.text) + ", &list" +
+          std::to_string(s.list) + ", " + a[0] + ", " + a[1] + ", " + a[2] + ", " +
+          std::to_string(s.leaf) + ")";
+      break;
+    case RCompute::ListFold:
+      e = "sicm_list_fold(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
+          kFoldOps[s.leaf] + ", " + a[0] + ", " + a[1] + ", " + (s.backward ? "1" : "0") + ")";
+      break;
+    case RCompute::Min:
+      e = "isnan(" + a[0] + ") || isnan(" + a[1] + ") ? NAN : fmin(" + a[0] + ", " + a[1] + ")";
+      break;
+    }
+    return e;
+  }
+
+  std::string frame(const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    code += "plot" + std::to_string(s.plot) + " = sicm_program_frame(" + site(s.loc) + ", " +
+            c_string_literal(s.text) + ", " +
+            (s.title.empty() ? std::string("NULL") : c_string_literal(s.title)) + ", " + a[0] +
+            ", " + a[1] + ", " + a[2] + ", " + a[3] + ");\n";
+    if (!s.axis_labels.empty())
+      code += "sicm_program_plot_labels(" + site(s.loc) + ", plot" + std::to_string(s.plot) +
+              ", " + c_string_literal(s.axis_labels[0]) + ", " +
+              (s.axis_labels.size() > 1 ? c_string_literal(s.axis_labels[1]) : "NULL") + ");\n";
+    return code;
+  }
+
+  std::string plot_point(const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    code += "sicm_program_plot_point(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
+            a[0] + ", " + a[1] + ");\n";
+    return code;
+  }
+
+  std::string plot_line(const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    code += "sicm_program_plot_line(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
+            a[0] + ", " + a[1] + ", " + a[2] + ", " + a[3] + ");\n";
+    return code;
+  }
+
+  std::string set_cell(const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    code += "cell" + std::to_string(s.cell) + " = " + a[0] + ";\n";
+    return code;
+  }
+
+  std::string list_new(const RStmt &s) {
+    return "sicm_list_reset(&list" + std::to_string(s.list) + ", " +
+           std::to_string(p_.lists[s.list].width) + ");\n";
+  }
+
+  std::string list_push(const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    code += "sicm_list_push(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
+            (a.empty() ? std::string("NULL") : "(const double[]){" + join(a) + "}") + ");\n";
+    return code;
+  }
+
+  std::string list_const(const RStmt &s) {
+    const RTable &t = p_.tables[static_cast<size_t>(s.leaf)];
+    size_t count = t.width ? t.data.size() / static_cast<size_t>(t.width) : 0;
+    return "sicm_list_assign(" + site(s.loc) + ", &list" + std::to_string(s.list) + ", " +
+           std::to_string(t.width) + ", table" + std::to_string(s.leaf) + ", " +
+           std::to_string(count) + ");\n";
+  }
+
+  // A call of the runtime that gives one number: into outs[0] if anyone
+  // reads it, else evaluated for its effects (a failure, a plot).
+  std::string single_result(int f, const RStmt &s, const std::string &call) {
+    if (used_[f].count(s.outs[0])) return decl(f, s.outs[0]) + " = " + call + ";\n";
+    return "(void)" + call + ";\n";
+  }
+
+  std::string integral_or_root(int f, const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    const char *fn = s.kind == RKind::Integral ? "sicm_drive_integral" : "sicm_drive_find_root";
+    std::string call = std::string(fn) + "(" + site(s.loc) + ", " + closure(s.callee) + ", " +
+                       a[0] + ", " + a[1] + ", " + c_double_literal(s.number) + ")";
+    return code + single_result(f, s, call);
+  }
+
+  std::string bisect(int f, const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    std::string call = "sicm_drive_bisect(" + site(s.loc) + ", " + closure(s.callee) + ", " +
+                       a[0] + ", " + a[1] + ", " + a[2] + ", " +
+                       std::to_string(static_cast<long>(s.number)) + ")";
+    return code + single_result(f, s, call);
+  }
+
+  std::string minimize(int f, const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    code += "double " + prefix + "out[3];\n";
+    code += "sicm_drive_minimize(" + site(s.loc) + ", " + closure(s.callee) + ", " + a[0] + ", " +
+            a[1] + ", " + c_double_literal(s.number) + ", " + prefix + "out);\n";
+    code += unpack(f, s.outs, prefix + "out");
+    return code;
+  }
+
+  std::string multimin(int f, const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    std::string x = prefix + "x";
+    code += "double " + x + "[] = {" + join(a) + "};\n";
+    code += "sicm_drive_multimin(" + site(s.loc) + ", " + closure(s.callee) + ", " +
+            std::to_string(a.size()) + ", " + x + ", " + c_double_literal(s.number) + ");\n";
+    code += unpack(f, s.outs, x);
+    return code;
+  }
+
+  // Advance's operands are the state then dt; Evolve's the state, dt and
+  // the final time.
+  std::string advance_or_evolve(int f, const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    size_t extra = s.kind == RKind::Advance ? 1 : 2;
+    size_t dim = a.size() - extra;
+    std::string y = prefix + "y";
+    code += "double " + y + "[] = {" + join({a.begin(), a.begin() + dim}) + "};\n";
+    if (s.kind == RKind::Advance)
+      code += "sicm_drive_advance(" + site(s.loc) + ", &" + ode(s, dim) + ", " + y + ", " +
+              a[dim] + ");\n";
+    else
+      code += "sicm_drive_evolve(" + site(s.loc) + ", &" + ode(s, dim) + ", " +
+              closure(s.first_monitor >= 0 ? s.first_monitor : s.monitor) + ", " +
+              closure(s.monitor) + ", " + y + ", " + a[dim] + ", " + a[dim + 1] + ");\n";
+    code += unpack(f, s.outs, y);
+    return code;
+  }
+
+  // Continue and Break: every new value is computed before any is
+  // assigned (one may read another's old value), then the jump.
+  std::string loop_exit(const RStmt &s, const std::string &prefix, const std::vector<int> &targets,
+                        const char *jump) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    for (size_t i = 0; i < targets.size(); ++i)
+      code += var_name(targets[i]) + " = " + a[i] + ";\n";
+    return code + jump;
   }
 
   // A parallel-map: the members' closures, their inputs and room for their

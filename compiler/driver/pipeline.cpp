@@ -51,6 +51,7 @@
 #include "codegen/emit_c.hpp"
 #include "codegen/kernel.hpp"
 #include "codegen/kernel_report.hpp"
+#include "codegen/residual_check.hpp"
 #include "codegen/residual_dump.hpp"
 #include "codegen/residual_emit.hpp"
 #include "driver/build_exe.hpp"
@@ -176,6 +177,7 @@ int build_program(const BuildOptions &o) {
   ResidualProgram &program = build.program();
   program.source_name = base_name(o.input);
   run_source(file);
+  check_residual(program, "partial evaluation");
   if (int status = check_parameter_options()) return status;
   if (o.dump == "residual") {
     std::fputs(dump_residual(program).c_str(), stdout);

@@ -169,14 +169,6 @@ struct Pending {
   }
 };
 
-// Does the reader complain only because the text stops too early?
-bool is_incomplete(const Error &e) {
-  std::string_view msg = e.what();
-  for (const char *s : {"never closed", "unterminated", "end of input"})
-    if (msg.find(s) != std::string_view::npos) return true;
-  return false;
-}
-
 // Read the pending text and evaluate the forms not evaluated yet. Returns
 // false if the text ends inside a datum and more lines may finish it (at end
 // of input that is reported as the error it then is).
@@ -192,7 +184,8 @@ bool feed(Pending &p, bool at_eof) {
       eval_and_print(form);
     }
   } catch (const Error &e) {
-    if (is_incomplete(e) && !at_eof) return false;
+    // The reader complains only because the text stops too early.
+    if (e.cause == ErrorCause::IncompleteInput && !at_eof) return false;
     report(e);
   }
   return true;

@@ -85,7 +85,7 @@ const char kMarkerSuffix[] = "__";
 } // namespace
 
 [[noreturn]] void cannot_compile(SrcLoc loc, const std::string &what) {
-  throw Error(ErrorKind::Syntax, loc, "cannot compile: " + what,
+  throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, loc, "cannot compile: " + what,
               "sicm build leaves only numerical work for run time; `sicm run` interprets this "
               "program");
 }
@@ -317,25 +317,6 @@ void read_cells() {
 
 // Run a numerical primitive, tracing it again whenever a traced procedure
 // turns a global into a cell (or widens a cell from counts to reals).
-ProgramMark mark_program() {
-  std::vector<RStmt> *block = g_build->blocks.empty() ? nullptr : g_build->blocks.back();
-  return {g_build->program.functions.size(), g_build->program.vars.size(), current().body.size(),
-          block, block ? block->size() : 0};
-}
-
-void rewind_program(const ProgramMark &mark) {
-  for (size_t v = mark.nvars; v < g_build->program.vars.size(); ++v)
-    g_build->var_ids.erase(g_build->program.vars[v].sym);
-  g_build->program.functions.resize(mark.nfunctions);
-  g_build->program.vars.resize(mark.nvars);
-  std::vector<RStmt> &body = current().body;
-  body.erase(body.begin() + static_cast<long>(mark.nbody), body.end());
-  // A block of an alternative or a loop that was current (kernel
-  // parameters are defined there: pe/numerics.cpp).
-  if (mark.block && mark.block->size() > mark.nblock)
-    mark.block->erase(mark.block->begin() + static_cast<long>(mark.nblock), mark.block->end());
-}
-
 Value with_retrace(const std::function<Value()> &body) {
   size_t depth = g_build->open.size();
   if (depth != 1) return body(); // the outermost primitive retraces
@@ -344,12 +325,12 @@ Value with_retrace(const std::function<Value()> &body) {
   // for the primitive's place (its errors and sites name the call).
   const SrcLoc call = current_call_loc();
   for (;;) {
-    ProgramMark mark = mark_program();
+    Checkpoint mark;
     reset_call_loc(call);
     try {
       return body();
     } catch (const Retrace &) {
-      rewind_program(mark);
+      mark.restore();
       for (size_t i = 0; i < g_build->program.cells.size(); ++i) {
         if (g_build->cell_initialized[i]) continue;
         g_build->cell_initialized[i] = true;
@@ -361,7 +342,7 @@ Value with_retrace(const std::function<Value()> &body) {
 }
 
 bool is_cannot_compile(const Error &e) {
-  return e.kind == ErrorKind::Syntax && std::string_view(e.what()).starts_with("cannot compile: ");
+  return e.cause == ErrorCause::CannotCompile;
 }
 
 Value let(RCompute c, std::vector<ExprId> args, RType type) {

@@ -36,6 +36,7 @@
 
 #include "base/limits.hpp"
 #include "codegen/jit.hpp"
+#include "codegen/residual_check.hpp"
 #include "codegen/residual_emit.hpp"
 #include "eval/core.hpp"
 #include "eval/procedure.hpp"
@@ -186,8 +187,9 @@ CompiledFn compile_traced_for_run(Value proc, const std::function<int()> &trace,
       TraceForRun build;
       id = trace();
       program = std::move(build.program());
+      check_residual(program, "the partial evaluation for sicm run");
     } catch (const Error &e) {
-      if (std::string_view(e.what()) == "Interrupted") throw;
+      if (e.cause == ErrorCause::Interrupted) throw;
       *why_not = e.what();
       return nullptr;
     } catch (...) { // an escape from the procedure: it will escape when interpreted, too
@@ -196,7 +198,10 @@ CompiledFn compile_traced_for_run(Value proc, const std::function<int()> &trace,
     }
   }
   program.source_name = procedure_name(proc);
-  if (program.functions.size() == 2) inline_kernel_parameters(program, id);
+  if (program.functions.size() == 2) {
+    inline_kernel_parameters(program, id);
+    check_residual(program, "inline_kernel_parameters");
+  }
   if (program.functions.size() != 2 || !program.functions[0].body.empty() ||
       !program.cells.empty() || !program.lists.empty() || program.plots != 0 ||
       !only_arithmetic(program.functions[id].body)) {

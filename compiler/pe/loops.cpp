@@ -193,13 +193,12 @@ Value record_continue(ActiveLoop &loop, Value *a, long n) {
   return g_build->bottom;
 }
 
-// Restores the builder's stacks and the program's size when a loop attempt
-// ends, by return or by exception.
+// Restores the builder's stacks when a loop attempt ends, by return or by
+// exception; roll_back forgets what it made.
 class LoopAttempt {
 public:
   LoopAttempt(ActiveLoop *loop, std::vector<RStmt> *block)
-      : nfunctions_(g_build->program.functions.size()), nvars_(g_build->program.vars.size()),
-        nloops_(g_build->loops.size()), nblocks_(g_build->blocks.size()),
+      : nloops_(g_build->loops.size()), nblocks_(g_build->blocks.size()),
         nundo_(g_build->undo.size()) {
     g_build->loops.push_back(loop);
     g_build->blocks.push_back(block);
@@ -216,15 +215,13 @@ public:
   void roll_back() {
     for (auto a = log_.rbegin(); a != log_.rend(); ++a)
       *a->place = a->before;
-    for (size_t v = nvars_; v < g_build->program.vars.size(); ++v)
-      g_build->var_ids.erase(g_build->program.vars[v].sym);
-    g_build->program.functions.resize(nfunctions_);
-    g_build->program.vars.resize(nvars_);
+    checkpoint_.restore();
   }
   const gcvec<Assignment> &log() const { return log_; }
 
 private:
-  size_t nfunctions_, nvars_, nloops_, nblocks_, nundo_;
+  Checkpoint checkpoint_; // first: taken before the attempt's block is pushed
+  size_t nloops_, nblocks_, nundo_;
   gcvec<Assignment> log_;
 };
 
@@ -444,16 +441,12 @@ bool evaluate_as_loop(Value f, Value *slots, long n, Value *out, bool from_known
 namespace {
 
 // Undoes what evaluating something tentatively made: the statements go to
-// `block`, assignments to older variables are logged, and roll_back forgets
-// the variables, functions, lists and tables it made.
+// `block`, assignments to older variables are logged, and roll_back undoes
+// them and forgets the rest (a Checkpoint).
 class Trial {
 public:
   explicit Trial(std::vector<RStmt> *block)
-      : nfunctions_(g_build->program.functions.size()), nvars_(g_build->program.vars.size()),
-        nlists_(g_build->program.lists.size()), ntables_(g_build->program.tables.size()),
-        nblocks_(g_build->blocks.size()), nundo_(g_build->undo.size()) {
-    for (Value *place : list_cell_places())
-      saved_lists_.push_back(*place);
+      : nblocks_(g_build->blocks.size()), nundo_(g_build->undo.size()) {
     g_build->blocks.push_back(block);
     g_build->undo.push_back(&log_);
     g_build->undo_serials.push_back(g_frame_serial);
@@ -469,30 +462,15 @@ public:
   void roll_back() {
     for (auto a = log_.rbegin(); a != log_.rend(); ++a)
       *a->place = a->before;
-    for (size_t v = nvars_; v < g_build->program.vars.size(); ++v)
-      g_build->var_ids.erase(g_build->program.vars[v].sym);
-    g_build->program.functions.resize(nfunctions_);
-    g_build->program.vars.resize(nvars_);
-    g_build->program.tables.resize(ntables_);
-    bool lists_in_use = false; // by a list cell started meanwhile
-    for (const ListCell &c : g_build->list_cells)
-      lists_in_use = lists_in_use || c.list >= static_cast<int>(nlists_);
-    if (!lists_in_use) {
-      g_build->program.lists.resize(nlists_);
-      g_build->list_shapes.resize(nlists_);
-      g_build->list_types.resize(nlists_);
-    }
-    std::vector<Value *> places = list_cell_places();
-    for (size_t i = 0; i < saved_lists_.size() && i < places.size(); ++i)
-      *places[i] = saved_lists_[i];
+    checkpoint_.restore();
   }
-  size_t nfunctions() const { return nfunctions_; }
+  size_t nfunctions() const { return checkpoint_.nfunctions(); }
   const gcvec<Assignment> &log() const { return log_; }
 
 private:
-  size_t nfunctions_, nvars_, nlists_, ntables_, nblocks_, nundo_;
+  Checkpoint checkpoint_; // first: taken before the trial's block is pushed
+  size_t nblocks_, nundo_;
   gcvec<Assignment> log_;
-  gcvec<Value> saved_lists_;
 };
 
 // Keep what a Trial made, once it has ended: its statements follow in the

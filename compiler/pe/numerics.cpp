@@ -116,12 +116,11 @@ Value kernel_input_like(Value sample) {
 
 // Where the parameters of the kernel being traced are defined: the block the
 // caller was in when the trace began (an index into g_build->blocks, whose
-// entry may be null for the function's body), and what it held then.
+// entry may be null for the function's body).
 struct ParameterSite {
   int traced;           // the traced function; its vars and those of functions after it are its own
   int parent;           // the function that calls it
   size_t block;         // g_build->blocks.size() before the trace's function opened
-  size_t block_size;    // the statements the caller's block had then
   std::unordered_set<int> parameters;        // the variables define_parameter made
   std::unordered_map<ExprId, bool> captured; // memo of is_captured
 };
@@ -174,29 +173,26 @@ void define_parameter(Symbol *sym, Value value) {
   caller_block(site).push_back(std::move(s));
 }
 
-// The site of a kernel trace while it lives; rollback() removes what it
-// defined in the caller's block when the trace is abandoned, as it is when
-// an exception leaves the scope (a retrace, a failed trace: the program's
-// variables are rewound, so their definitions must go too).
+// The site of a kernel trace while it lives; rollback() forgets what the
+// trace made (a Checkpoint), as it must when an exception leaves the scope
+// (a retrace, a failed trace: the parameters' definitions in the caller's
+// block go with the variables).
 class KernelTraceScope {
 public:
   KernelTraceScope() : outer_(g_site), exceptions_(std::uncaught_exceptions()) {
     site_.traced = static_cast<int>(g_build->program.functions.size());
     site_.parent = g_build->open.back();
     site_.block = g_build->blocks.size();
-    site_.block_size = caller_block(site_).size();
     g_site = &site_;
   }
   ~KernelTraceScope() {
     if (std::uncaught_exceptions() > exceptions_) rollback();
     g_site = outer_;
   }
-  void rollback() {
-    std::vector<RStmt> &b = caller_block(site_);
-    if (b.size() > site_.block_size) b.erase(b.begin() + static_cast<long>(site_.block_size), b.end());
-  }
+  void rollback() { checkpoint_.restore(); }
 
 private:
+  Checkpoint checkpoint_; // the caller's block is the current one
   ParameterSite site_;
   ParameterSite *outer_;
   int exceptions_;
@@ -428,12 +424,12 @@ Value bisect_at_run_time(Value *a, int n) {
 // `why_not` says so.
 Value computed_while_compiling(const char *name, Value *a, int n,
                                const std::function<void()> &why_not) {
-  ProgramMark mark = mark_program();
+  Checkpoint mark;
   try {
     return call_original(name, a, n);
   } catch (const Error &e) {
     if (!is_cannot_compile(e)) throw;
-    rewind_program(mark);
+    mark.restore();
   }
   why_not();
   SICM_ASSERT(false); // why_not throws
@@ -446,13 +442,13 @@ Value computed_while_compiling(const char *name, Value *a, int n,
 Value P_bisect(Value *a, int n) {
   bool known = is_number(a[1]) && is_number(a[2]) && is_number(a[3]) &&
                (n < 5 || a[4].is(Tag::Default) || is_number(a[4]));
-  ProgramMark mark = mark_program();
+  Checkpoint mark;
   const SrcLoc call = current_call_loc(); // the trace moves it into the function
   try {
     return bisect_at_run_time(a, n);
   } catch (const Error &e) {
     if (!known || !is_cannot_compile(e)) throw;
-    rewind_program(mark);
+    mark.restore();
     reset_call_loc(call);
     Error why = e;
     return computed_while_compiling("bisect", a, n, [&] { throw why; });
@@ -636,7 +632,6 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
   if (s.method != "sicm_ode_step_msbdf" && s.method != "sicm_ode_step_cvode_bdf") return;
   Symbol *d = intern("D").symbol();
   if (!d->bound) return;
-  size_t nfunctions = g_build->program.functions.size(), nvars = g_build->program.vars.size();
   KernelTraceScope parameters;
   try {
     FunctionScope scope("jacobian");
@@ -654,10 +649,6 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
     s.jacobian = scope.id();
   } catch (const Error &) {
     parameters.rollback();
-    for (size_t v = nvars; v < g_build->program.vars.size(); ++v)
-      g_build->var_ids.erase(g_build->program.vars[v].sym);
-    g_build->program.functions.resize(nfunctions);
-    g_build->program.vars.resize(nvars);
     s.jacobian = -1;
   }
 }

@@ -180,15 +180,31 @@ void set_cell(int cell, Value v);
 void read_cells();
 // Run a numerical primitive, tracing it again on Retrace.
 Value with_retrace(const std::function<Value()> &body);
-// How far the program had got (functions, variables, statements of the
-// current function), and going back there to abandon a trace.
-struct ProgramMark {
-  size_t nfunctions, nvars, nbody;
-  std::vector<RStmt> *block; // the current block when it is not the body, or null
-  size_t nblock;             // its statements then
+// How far the build had got when an attempt at residual code began (a
+// trace that may be retraced or fail, a loop tried as a C loop, a call
+// evaluated tentatively), and restore() to forget everything the attempt
+// made: the program's functions, variables (and their symbols' entries in
+// var_ids and parameter_values), lists and tables, the statements added to
+// the current function's body and to the current block, and the values of
+// the list cells' variables. Defined in pe/checkpoint.cpp, which says what
+// it leaves alone and why (cells, effort counters, the evaluator's
+// variables: each attempt's scope undoes its own assignment log).
+class Checkpoint {
+public:
+  Checkpoint();
+  Checkpoint(const Checkpoint &) = delete;
+  Checkpoint &operator=(const Checkpoint &) = delete;
+  void restore() const;
+  size_t nfunctions() const { return nfunctions_; }
+
+private:
+  size_t nfunctions_, nvars_, nlists_, ntables_;
+  int function_;             // the current function, or -1
+  size_t nbody_;             // its statements then
+  std::vector<RStmt> *block_; // the current block when it is not the body, or null
+  size_t nblock_;            // its statements then
+  gcvec<Value> list_places_; // the list cells' variables then
 };
-ProgramMark mark_program();
-void rewind_program(const ProgramMark &mark);
 // Is e cannot_compile's error?
 bool is_cannot_compile(const Error &e);
 // A new variable of the given type computed by c from args.

@@ -26,6 +26,12 @@ constexpr NamedChar kNamedChars[] = {
     {"delete", 127},  {"rubout", 127},    {"alarm", 7},    {"page", 12},
 };
 
+// The text stops inside a datum: an error for a file, but the REPL reads
+// another line and tries again (driver/repl.cpp).
+[[noreturn]] void incomplete_input(SrcLoc loc, const std::string &msg) {
+  throw Error(ErrorKind::Syntax, ErrorCause::IncompleteInput, loc, msg);
+}
+
 } // namespace
 
 Reader::Reader(uint32_t file) : file_(file), text_(source_text(file)) {}
@@ -55,7 +61,7 @@ void Reader::skip_block_comment(SrcLoc start) {
   int nesting = 1;
   while (nesting > 0) {
     int c = get();
-    if (c == EOF) syntax_error(start, "unterminated block comment: this '#|' is never closed");
+    if (c == EOF) incomplete_input(start, "unterminated block comment: this '#|' is never closed");
     if (c == '|' && peek() == '#') {
       get();
       --nesting;
@@ -109,7 +115,7 @@ Value Reader::read_datum(SrcLoc &loc) {
   loc = here();
   int c = peek();
   switch (c) {
-  case EOF: syntax_error(loc, "unexpected end of input: a datum was expected");
+  case EOF: incomplete_input(loc, "unexpected end of input: a datum was expected");
   case '(':
   case '[': {
     get();
@@ -149,7 +155,7 @@ Value Reader::read_list(char close, SrcLoc open) {
     skip_atmosphere();
     int c = peek();
     if (c == EOF)
-      syntax_error(open, std::string("unbalanced parentheses: this '") +
+      incomplete_input(open, std::string("unbalanced parentheses: this '") +
                              (close == ')' ? '(' : '[') + "' is never closed");
     if (c == ')' || c == ']') {
       if (c != close)
@@ -170,7 +176,8 @@ Value Reader::read_list(char close, SrcLoc open) {
       tail = read_datum(tl);
       skip_atmosphere();
       if (peek() != close) {
-        if (peek() == EOF) syntax_error(open, "unbalanced parentheses: this '(' is never closed");
+        if (peek() == EOF)
+          incomplete_input(open, "unbalanced parentheses: this '(' is never closed");
         syntax_error(here(), "ill-formed dotted list: more than one datum after '.'");
       }
       get();
@@ -192,7 +199,7 @@ Value Reader::read_string(SrcLoc start) {
   std::string s;
   for (;;) {
     int c = get();
-    if (c == EOF) syntax_error(start, "unterminated string: this '\"' is never closed");
+    if (c == EOF) incomplete_input(start, "unterminated string: this '\"' is never closed");
     if (c == '"') break;
     if (c != '\\') {
       s += static_cast<char>(c);
@@ -244,7 +251,7 @@ Value Reader::read_string(SrcLoc start) {
         get();
       break;
     }
-    case EOF: syntax_error(start, "unterminated string: this '\"' is never closed");
+    case EOF: incomplete_input(start, "unterminated string: this '\"' is never closed");
     default:
       if (e == ' ' || e == '\t') {
         // "\   <newline>  " is also a continuation.
@@ -279,7 +286,7 @@ Value Reader::read_hash(SrcLoc start) {
   }
   if (c == '\\') {
     get();
-    if (peek() == EOF) syntax_error(start, "unexpected end of input after '#\\'");
+    if (peek() == EOF) incomplete_input(start, "unexpected end of input after '#\\'");
     // The first character is taken even if it is a delimiter: #\( #\space
     size_t begin = pos_;
     size_t len = 0;
@@ -339,10 +346,10 @@ Value Reader::read_atom(SrcLoc start) {
     std::string name;
     for (;;) {
       int c = get();
-      if (c == EOF) syntax_error(start, "unterminated |symbol|");
+      if (c == EOF) incomplete_input(start, "unterminated |symbol|");
       if (c == '|') break;
       if (c == '\\') c = get();
-      if (c == EOF) syntax_error(start, "unterminated |symbol|");
+      if (c == EOF) incomplete_input(start, "unterminated |symbol|");
       name += static_cast<char>(c);
     }
     return intern(name);

@@ -151,3 +151,25 @@ TEST(Reader, DeepNestingIsAnErrorNotACrash) {
   std::string deep(kMaxReadDepth + 10, '(');
   EXPECT_NE(error_of_on_big_stack(deep).find("nested too deeply"), std::string::npos);
 }
+
+namespace {
+
+ErrorCause cause_of(const std::string &text) {
+  try {
+    read_text(text);
+  } catch (const Error &e) {
+    return e.cause;
+  }
+  return ErrorCause::Other;
+}
+
+} // namespace
+
+// The REPL reads another line when the reader runs out of text inside a
+// datum; it tells that from other errors by the cause, not the message.
+TEST(Reader, IncompleteInputIsItsOwnCause) {
+  for (const char *text : {"(+ 1", "[1 2", "\"abc", "#| comment", "'", "#\\", "|sym", "(a . b"})
+    EXPECT_EQ(cause_of(text), ErrorCause::IncompleteInput) << text;
+  for (const char *text : {")", "(a . b c)", "#q", "(1 ]"})
+    EXPECT_EQ(cause_of(text), ErrorCause::Other) << text;
+}
