@@ -3,6 +3,18 @@
 
 namespace sicm {
 
+namespace {
+TopLevelProbe g_top_level_probe = nullptr;
+} // namespace
+
+void set_top_level_probe(TopLevelProbe probe) {
+  g_top_level_probe = probe;
+}
+
+bool raised_at_top_level() {
+  return g_top_level_probe && g_top_level_probe();
+}
+
 void syntax_error(SrcLoc loc, const std::string &msg) {
   throw Error(ErrorKind::Syntax, loc, msg);
 }

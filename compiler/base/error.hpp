@@ -41,11 +41,21 @@ enum class ErrorCause : uint8_t {
 constexpr int kExitCompileError = 65; // EX_DATAERR
 constexpr int kExitRuntimeError = 70; // EX_SOFTWARE
 
+// Is the program being compiled at its top level, outside every procedure
+// traced for run time and every alternative of a run-time test? sicm build
+// answers (pe/build_mode.cpp) while it lives; null otherwise. An error
+// raised there is certain to happen when the program runs, at that point
+// of it: the build makes it the program's failure (driver/pipeline.cpp).
+using TopLevelProbe = bool (*)();
+void set_top_level_probe(TopLevelProbe probe);
+bool raised_at_top_level();
+
 struct Error : std::runtime_error {
   ErrorKind kind;
   ErrorCause cause = ErrorCause::Other;
   SrcLoc loc;
   std::string note; // optional extra line (e.g. "did you mean ...")
+  bool at_top_level = raised_at_top_level(); // of a program sicm build compiles
   Error(ErrorKind k, SrcLoc l, std::string msg, std::string n = {})
       : std::runtime_error(std::move(msg)), kind(k), loc(l), note(std::move(n)) {}
   Error(ErrorKind k, ErrorCause c, SrcLoc l, std::string msg, std::string n = {})

@@ -92,7 +92,8 @@ enum class RKind : uint8_t {
   ParallelMap, // parallel-map: member i is function members[i] (or members[0] for all) applied
                // to args[i*w .. i*w+w) (w = args / count); its outputs are the next ones of
                // outs, member by member (sicm_parallel_map runs them on threads and ranks)
-  Fail,        // never reached at compile time; unused for now
+  Fail,        // the program fails here: `text` is the whole message for stderr (an error
+               // the build met at the program's top level, which sicm run raises there)
 };
 
 struct RStmt {

@@ -240,8 +240,8 @@ private:
     for (ExprId a : s.args)
       uses(a);
     switch (s.kind) {
-    case RKind::Text:
-    case RKind::Fail: break;
+    case RKind::Text: break;
+    case RKind::Fail: require(!s.text.empty(), "fails without a message"); break;
     case RKind::Let: let(s); break;
     case RKind::Print: use(s.var); break;
     case RKind::Frame:

@@ -176,7 +176,18 @@ int build_program(const BuildOptions &o) {
   BuildSession build;
   ResidualProgram &program = build.program();
   program.source_name = base_name(o.input);
-  run_source(file);
+  try {
+    run_source(file);
+  } catch (const Error &e) {
+    // An error of the program itself, met where it is certain to happen
+    // when the program runs: the executable prints what comes before it and
+    // then fails with it, as sicm run does. Anything else (cannot compile,
+    // a limit, an error inside code left for run time) fails the build.
+    if (e.kind != ErrorKind::Runtime || e.cause != ErrorCause::Other || !e.at_top_level) throw;
+    build.fail_here(e);
+    std::fprintf(stderr, "%s: warning: the program fails here when it runs: %s\n",
+                 loc_text(e.loc).c_str(), e.what());
+  }
   check_residual(program, "partial evaluation");
   if (int status = check_parameter_options()) return status;
   if (o.dump == "residual") {

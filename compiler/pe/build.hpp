@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "base/error.hpp"
 #include "builtins/numerics.hpp"
 #include "codegen/residual.hpp"
 
@@ -28,6 +29,10 @@ public:
   BuildSession &operator=(const BuildSession &) = delete;
 
   ResidualProgram &program();
+  // The program fails at this point when it runs, with e's message as sicm
+  // run prints it (e was raised at the top level: e.at_top_level): the
+  // output before it is printed first, then the executable exits 70.
+  void fail_here(const Error &e);
 
 private:
   build::BuildState *state_; // in memory the collector scans (it holds Values)

@@ -722,6 +722,14 @@ bool in_build_mode() {
 
 namespace {
 
+// Outside every traced function, alternative of a run-time test and loop
+// left for run time: where an error is the program's, at that point.
+bool at_program_top_level() {
+  using namespace build;
+  return g_build->open.size() == 1 && g_build->blocks.size() == 1 && g_build->branch_depth == 0 &&
+         g_build->loops.empty();
+}
+
 // Rebind the primitives and install the evaluator's hooks so that what runs
 // from now on records into state's program.
 void begin_build_mode(build::BuildState *state) {
@@ -750,6 +758,7 @@ void begin_build_mode(build::BuildState *state) {
   set_output_hook(residual_output);
   set_capture_hook(hook_capture);
   set_print_preparer(prepare_toplevel);
+  set_top_level_probe(at_program_top_level);
   g_dynamic_branch_hooks = &kHooks;
 }
 
@@ -766,6 +775,7 @@ void end_build_mode() {
   set_capture_hook(nullptr);
   set_print_preparer(nullptr);
   set_run_time_value_test(nullptr);
+  set_top_level_probe(nullptr);
   g_build = nullptr;
 }
 
@@ -786,6 +796,15 @@ BuildSession::~BuildSession() {
 
 ResidualProgram &BuildSession::program() {
   return state_->program;
+}
+
+void BuildSession::fail_here(const Error &e) {
+  SICM_ASSERT(build::g_build == state_ && e.at_top_level);
+  flush_output(); // what the program printed before, in its place
+  RStmt s{RKind::Fail};
+  s.loc = e.loc;
+  s.text = format_error(e); // the bytes sicm run writes on stderr
+  build::emit(std::move(s));
 }
 
 } // namespace sicm

@@ -620,7 +620,8 @@ void trace_singular_factors(Value state, RStmt &s) {
   for (int v : current().inputs)
     to.push_back(g_build->program.vars[v].sym);
   current().outputs = with_inputs(factors.values, from, to);
-  current().kernel = true;
+  drop_unused_cell_reads(current());
+  current().kernel = current().body.empty();
   s.probe = scope.id();
   s.probe_texts = std::move(factors.texts);
 }

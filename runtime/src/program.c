@@ -205,6 +205,10 @@ void sicm_program_fail(const sicm_site *site, const char *who, const char *reaso
   sicm_program_fail_message(message);
 }
 
+void sicm_program_fail_diagnostic(const char *diagnostic) {
+  sicm_program_fail_message(diagnostic);
+}
+
 /* ---- printing --------------------------------------------------------------------- */
 
 void sicm_program_write(const char *s, size_t len) {

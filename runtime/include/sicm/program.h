@@ -69,6 +69,16 @@ void sicm_program_fail(const sicm_site *site, const char *who, const char *reaso
 #endif
     ;
 
+/* sicm_program_fail_diagnostic prints diagnostic (a whole message, source
+ * line and caret, as the compiler formats its own: an error sicm build met
+ * at the program's top level, which sicm run raises at that point) on
+ * stderr, finishes every plot and exits with status 70. */
+void sicm_program_fail_diagnostic(const char *diagnostic)
+#if defined(__GNUC__)
+    __attribute__((noreturn))
+#endif
+    ;
+
 /* The operations of the program's own arithmetic (not of kernels) that
  * sicm run would not answer with a real number: they fail at `site` as the
  * interpreter does where it raises an error (division by zero: "Division by
