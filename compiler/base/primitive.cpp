@@ -45,11 +45,36 @@ RunTimeValueTest g_run_time_value_test = nullptr;
 
 // A primitive that only sicm run computes, given a value known only at run
 // time by sicm build.
+// Does v hold a value known only at run time in a structure, vector or
+// list (looked into to a bounded depth and size)? Its message would show
+// the build's names for them, not the numbers sicm run shows.
+bool holds_run_time_value(Value v, int depth = 4) {
+  if (g_run_time_value_test(v)) return true;
+  if (depth == 0) return false;
+  const Value *items = nullptr;
+  size_t len = 0;
+  if (v.is(Tag::Structure)) {
+    items = v.as<Structure>()->items;
+    len = v.as<Structure>()->len;
+  } else if (v.is(Tag::Vector)) {
+    items = v.vector()->items;
+    len = v.vector()->len;
+  } else if (v.is(Tag::Pair)) {
+    return holds_run_time_value(car(v), depth - 1) || holds_run_time_value(cdr(v), depth - 1);
+  }
+  for (size_t i = 0; i < len && i < 64; ++i)
+    if (holds_run_time_value(items[i], depth - 1)) return true;
+  return false;
+}
+
 void refuse_run_time_argument(Value obj, int argpos, const char *who) {
-  if (!g_run_time_value_test || !g_run_time_value_test(obj)) return;
+  if (!g_run_time_value_test || !holds_run_time_value(obj)) return;
+  bool number = g_run_time_value_test(obj);
   throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, current_call_loc(),
-              std::string("cannot compile: ") + who + " of a number known only at run time (its " +
-                  ordinal(argpos) + " argument)",
+              std::string("cannot compile: ") + who + " of " +
+                  (number ? "a number known only at run time"
+                          : "a value that holds numbers known only at run time") +
+                  " (its " + ordinal(argpos) + " argument)",
               "sicm build leaves only numerical work for run time; `sicm run` interprets this "
               "program");
 }

@@ -716,6 +716,7 @@ Value P_state_advancer(Value *a, int n) {
 Value run_evolve(NativeProc *self, Value *a, int n) {
   static const char who[] = "evolve";
   check_arguments(who, a, n, self);
+  Checkpoint before; // for a monitor whose trace fails (below)
   RStmt s{RKind::Evolve};
   s.loc = here();
   s.number = static_number(a, n, 4, kAdvancerTolerance, who);
@@ -728,11 +729,22 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   trace_singular_factors(a[0], s);
   trace_jacobian(self->a, a[0], s);
   Value monitor = a[1];
-  {
+  try {
     FunctionScope scope(procedure_name(monitor));
     Value x = input_like(a[0]);
     apply_procedure(monitor, &x, 1);
     s.monitor = scope.id();
+  } catch (const Error &e) {
+    // A monitor that fails on the traced state may fail at its first call
+    // in sicm run, on the initial state, with that state's numbers in the
+    // message: called so here, it raises that error where sicm run does
+    // (at the top level, the executable's failure). If it does not fail
+    // there, the trace's error stands.
+    if (e.cause == ErrorCause::Limit || e.cause == ErrorCause::Interrupted) throw;
+    Error traced = e;
+    before.restore();
+    apply_procedure(monitor, &a[0], 1);
+    throw traced;
   }
   // sicm run gives the monitor's first call the state as the program wrote
   // it: where that holds exact numbers (a time of 0), which print as exact,
