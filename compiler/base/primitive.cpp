@@ -45,28 +45,6 @@ RunTimeValueTest g_run_time_value_test = nullptr;
 
 // A primitive that only sicm run computes, given a value known only at run
 // time by sicm build.
-// Does v hold a value known only at run time in a structure, vector or
-// list (looked into to a bounded depth and size)? Its message would show
-// the build's names for them, not the numbers sicm run shows.
-bool holds_run_time_value(Value v, int depth = 4) {
-  if (g_run_time_value_test(v)) return true;
-  if (depth == 0) return false;
-  const Value *items = nullptr;
-  size_t len = 0;
-  if (v.is(Tag::Structure)) {
-    items = v.as<Structure>()->items;
-    len = v.as<Structure>()->len;
-  } else if (v.is(Tag::Vector)) {
-    items = v.vector()->items;
-    len = v.vector()->len;
-  } else if (v.is(Tag::Pair)) {
-    return holds_run_time_value(car(v), depth - 1) || holds_run_time_value(cdr(v), depth - 1);
-  }
-  for (size_t i = 0; i < len && i < 64; ++i)
-    if (holds_run_time_value(items[i], depth - 1)) return true;
-  return false;
-}
-
 void refuse_run_time_argument(Value obj, int argpos, const char *who) {
   if (!g_run_time_value_test || !holds_run_time_value(obj)) return;
   bool number = g_run_time_value_test(obj);
@@ -87,6 +65,26 @@ void set_run_time_value_test(RunTimeValueTest test) {
 
 RunTimeValueTest run_time_value_test() {
   return g_run_time_value_test;
+}
+
+bool holds_run_time_value(Value v, int depth) {
+  if (!g_run_time_value_test) return false;
+  if (g_run_time_value_test(v)) return true;
+  if (depth == 0) return false;
+  const Value *items = nullptr;
+  size_t len = 0;
+  if (v.is(Tag::Structure)) {
+    items = v.as<Structure>()->items;
+    len = v.as<Structure>()->len;
+  } else if (v.is(Tag::Vector)) {
+    items = v.vector()->items;
+    len = v.vector()->len;
+  } else if (v.is(Tag::Pair)) {
+    return holds_run_time_value(car(v), depth - 1) || holds_run_time_value(cdr(v), depth - 1);
+  }
+  for (size_t i = 0; i < len && i < 64; ++i)
+    if (holds_run_time_value(items[i], depth - 1)) return true;
+  return false;
 }
 
 void wrong_type(Value obj, int argpos, const char *who) {

@@ -47,6 +47,10 @@ void define_global(const char *name, Value v);
 using RunTimeValueTest = bool (*)(Value);
 void set_run_time_value_test(RunTimeValueTest test);
 RunTimeValueTest run_time_value_test(); // null outside sicm build
+// Does v hold such a value, itself or in a structure, vector or list
+// (looked into to a bounded depth and size)? An error message about it
+// would show the build's names for them, not the numbers sicm run shows.
+bool holds_run_time_value(Value v, int depth = 4);
 
 // MIT-style argument errors, raised at current_call_loc(). argpos is 1-based.
 //   "The object (), passed as the first argument to car, is not the correct type."

@@ -436,24 +436,31 @@ Value computed_while_compiling(const char *name, Value *a, int n,
   return Value::unspecified();
 }
 
-// bisect with a function that cannot be compiled (it builds streams, or
-// lists that it mutates, as the book's which-way? of section 4.6.1 does) but
-// with every number known now is computed while compiling.
-Value P_bisect(Value *a, int n) {
-  bool known = is_number(a[1]) && is_number(a[2]) && is_number(a[3]) &&
-               (n < 5 || a[4].is(Tag::Default) || is_number(a[4]));
+// A numerical primitive whose procedure cannot be compiled for run time
+// (bisect's which-way? of section 4.6.1 builds streams and lists it
+// mutates; an objective may return a symbol) but whose numbers are all
+// known now is computed while compiling, by sicm run's own primitive: the
+// program keeps its result, or fails where and as sicm run fails.
+template <PrimFn AtRunTime, const char *Name> Value traced_or_computed(Value *a, int n) {
+  bool known = true;
+  for (int i = 1; i < n; ++i)
+    known = known && !holds_run_time_value(a[i]);
   Checkpoint mark;
   const SrcLoc call = current_call_loc(); // the trace moves it into the function
   try {
-    return bisect_at_run_time(a, n);
+    return AtRunTime(a, n);
   } catch (const Error &e) {
     if (!known || !is_cannot_compile(e)) throw;
     mark.restore();
     reset_call_loc(call);
     Error why = e;
-    return computed_while_compiling("bisect", a, n, [&] { throw why; });
+    return computed_while_compiling(Name, a, n, [&] { throw why; });
   }
 }
+constexpr char kDefiniteIntegral[] = "definite-integral";
+constexpr char kMultidimensionalMinimize[] = "multidimensional-minimize";
+constexpr char kFindRoot[] = "find-root";
+constexpr char kBisect[] = "bisect";
 
 // nelder-mead is not compiled for run time: it is computed while compiling.
 Value P_nelder_mead(Value *a, int n) {
@@ -769,12 +776,15 @@ Value P_evolve(Value *a, int n) {
 } // namespace
 
 // What this file specializes (the table is pe/specialized.cpp).
-const PrimFn p_definite_integral = retrying<P_definite_integral>,
-             p_minimize = retrying<P_minimize<kMinimize>>,
-             p_brent_min = retrying<P_minimize<kBrentMin>>,
-             p_multidimensional_minimize = retrying<P_multidimensional_minimize>,
-             p_find_root = retrying<P_find_root>, p_nelder_mead = P_nelder_mead,
-             p_bisect = retrying<P_bisect>, p_state_advancer = P_state_advancer,
-             p_evolve = P_evolve;
+const PrimFn
+    p_definite_integral = retrying<traced_or_computed<P_definite_integral, kDefiniteIntegral>>,
+    p_minimize = retrying<traced_or_computed<P_minimize<kMinimize>, kMinimize>>,
+    p_brent_min = retrying<traced_or_computed<P_minimize<kBrentMin>, kBrentMin>>,
+    p_multidimensional_minimize =
+        retrying<traced_or_computed<P_multidimensional_minimize, kMultidimensionalMinimize>>,
+    p_find_root = retrying<traced_or_computed<P_find_root, kFindRoot>>,
+    p_nelder_mead = P_nelder_mead,
+    p_bisect = retrying<traced_or_computed<bisect_at_run_time, kBisect>>,
+    p_state_advancer = P_state_advancer, p_evolve = P_evolve;
 
 } // namespace sicm::build
