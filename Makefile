@@ -91,6 +91,11 @@ $(KERNEL_SOLVE_GEN): compiler/codegen/kernel_solve.inc scripts/embed-text
 $(BUILD)/gen/kernel_solve_text.o: $(KERNEL_SOLVE_GEN)
 	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -c $< -o $@
 
+# The kernel interpreter computes what the JIT'ed C computes only if no
+# multiply and add of it fuse into one rounding (the C is compiled with
+# -ffp-contract=off too: codegen/jit.cpp, driver/build_exe.cpp).
+$(BUILD)/compiler/codegen/kernel_interpreter.o: CXXFLAGS += -ffp-contract=off
+
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
