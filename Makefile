@@ -56,7 +56,11 @@ STDLIB_FILES  := $(addprefix stdlib/,prelude.sicm local.sicm numerics.sicm lagra
                    lie.sicm effects.sicm)
 STDLIB_GEN    := $(BUILD)/gen/stdlib_embed.cpp
 
-COMPILER_OBJS := $(COMPILER_SRCS:%.cpp=$(BUILD)/%.o) $(BUILD)/gen/stdlib_embed.o
+# The linear solves of kernels, as C text for the C emitter (codegen/emit_c.cpp).
+KERNEL_SOLVE_GEN := $(BUILD)/gen/kernel_solve_text.cpp
+
+COMPILER_OBJS := $(COMPILER_SRCS:%.cpp=$(BUILD)/%.o) $(BUILD)/gen/stdlib_embed.o \
+                 $(BUILD)/gen/kernel_solve_text.o
 RUNTIME_OBJS  := $(RUNTIME_SRCS:%.c=$(BUILD)/%.o) $(RUNTIME_CXX_SRCS:%.cpp=$(BUILD)/%.o)
 UNIT_OBJS     := $(UNIT_SRCS:%.cpp=$(BUILD)/%.o)
 # Everything of the compiler except its entry point, for the unit tests.
@@ -82,6 +86,17 @@ $(STDLIB_GEN): $(STDLIB_FILES) scripts/embed-stdlib
 
 $(BUILD)/gen/stdlib_embed.o: $(STDLIB_GEN)
 	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -c $< -o $@
+
+$(KERNEL_SOLVE_GEN): compiler/codegen/kernel_solve.inc scripts/embed-text
+	@python3 scripts/embed-text $@ kKernelSolveSource $<
+
+$(BUILD)/gen/kernel_solve_text.o: $(KERNEL_SOLVE_GEN)
+	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -c $< -o $@
+
+# The kernel interpreter computes what the JIT'ed C computes only if no
+# multiply and add of it fuse into one rounding (the C is compiled with
+# -ffp-contract=off too: codegen/jit.cpp, driver/build_exe.cpp).
+$(BUILD)/compiler/codegen/kernel_interpreter.o: CXXFLAGS += -ffp-contract=off
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)

@@ -19,7 +19,7 @@
 //     process (exit), or depend on the clock or a random state (runtime,
 //     real-time, random), which would make runs irreproducible;
 //   - output is discarded (set_output_hook), and SICM_INTERPRET=1 keeps the
-//     numerical primitives from compiling kernels.
+//     C compiler out (kernels, if any, run in the kernel interpreter).
 // Between inputs the global bindings are restored to what they were after
 // start-up (redefinitions undone, definitions of the names the program
 // mentions removed), so an input that redefines `car` does not change how

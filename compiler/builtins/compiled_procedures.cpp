@@ -2,12 +2,11 @@
 // (see compiled_procedures.hpp).
 #include "builtins/compiled_procedures.hpp"
 
-#include <cstdlib>
-#include <cstring>
 #include <string>
 
 #include "base/error.hpp"
 #include "base/primitive.hpp"
+#include "codegen/kernel_interpreter.hpp"
 #include "eval/procedure.hpp"
 
 namespace sicm {
@@ -38,18 +37,17 @@ constexpr size_t kCompiledMemo = 32;
 ScalarCompiler g_scalar_compiler = nullptr;
 SystemCompiler g_system_compiler = nullptr;
 
-bool kernels_enabled() {
-  static const bool enabled = [] {
-    const char *e = std::getenv("SICM_INTERPRET");
-    return !(e && *e && std::strcmp(e, "0") != 0);
-  }();
-  return enabled;
+// Under SICM_INTERPRET=1 there is no C compiler: kernels are still made,
+// and run by the kernel interpreter (compile_kernel), but what only the
+// partial evaluator's C can compile stays with the generic evaluator.
+bool c_compiler_enabled() {
+  return !kernels_interpreted();
 }
 
 } // namespace
 
 const Kernel *auto_kernel(Value sysder, Value state, size_t dim, bool taylor) {
-  if (!kernels_enabled() || !is_procedure(sysder)) return nullptr;
+  if (!is_procedure(sysder)) return nullptr;
   for (const CompiledSysder &c : g_compiled)
     if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape) && (c.taylor || !taylor))
       return c.kernel;
@@ -63,7 +61,7 @@ const Kernel *auto_kernel(Value sysder, Value state, size_t dim, bool taylor) {
 }
 
 CompiledFn auto_residual(Value sysder, Value state, const char *who) {
-  if (!kernels_enabled() || !g_system_compiler) return nullptr;
+  if (!c_compiler_enabled() || !g_system_compiler) return nullptr;
   CompiledSysder *entry = nullptr;
   for (CompiledSysder &c : g_compiled)
     if (eq(c.sysder, sysder) && value_has_shape(state, c.state_shape) && !c.kernel) entry = &c;
@@ -75,7 +73,6 @@ CompiledFn auto_residual(Value sysder, Value state, const char *who) {
 }
 
 const Kernel *jacobian_kernel(Value sysder, Value state, size_t dim) {
-  if (!kernels_enabled()) return nullptr;
   Symbol *d = intern("D").symbol();
   if (!d->bound) return nullptr;
   try {
@@ -89,7 +86,7 @@ const Kernel *jacobian_kernel(Value sysder, Value state, size_t dim) {
 }
 
 CompiledFn compile_expensive_function(Value f, const char *who) {
-  if (!kernels_enabled() || !g_scalar_compiler) return nullptr;
+  if (!c_compiler_enabled() || !g_scalar_compiler) return nullptr;
   std::string why_not;
   return g_scalar_compiler(f, who, &why_not);
 }

@@ -3,7 +3,9 @@
 // test the state, by sicm build's partial evaluator; expensive functions
 // given to bisect by the partial evaluator. Compiling is never required: a
 // null result means the procedure stays interpreted. SICM_INTERPRET=1 in the
-// environment turns all of it off.
+// environment keeps the C compiler out: kernels are run by the kernel
+// interpreter (codegen/kernel_interpreter.hpp), bit for bit as their C,
+// and what only the partial evaluator compiles is not compiled.
 #pragma once
 
 #include <cstddef>

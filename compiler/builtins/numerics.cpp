@@ -631,8 +631,8 @@ struct OdeProblem {
       return;
     }
     std::string why =
-        !cb.kernel ? "this one is interpreted, not compiled (it cannot be traced, SICM_INTERPRET "
-                     "is set, or --max-compiled-kernels was reached)"
+        !cb.kernel ? "this one is interpreted, not compiled (it cannot be traced, or "
+                     "--max-compiled-kernels was reached)"
         : cb.kernel->taylor_why_not.empty() ? "this one was compiled without them"
                                             : "this one has " + cb.kernel->taylor_why_not;
     numeric_error(cb.loc, cb.who,
@@ -646,7 +646,9 @@ struct OdeProblem {
   void record_site(const char *who, double t1, double eps, const sicm_ode_step_type *T) {
     if (!recording_integration_sites()) return;
     record_integration_site(IntegrationSite{
-        loc_text(cb.loc), who, cb.kernel ? cb.kernel->fn : nullptr,
+        // An interpreted kernel is recorded as none: sicm bench gives its
+        // functions the numbers of p[] (kernel_params, codegen/kernel.hpp).
+        loc_text(cb.loc), who, cb.kernel && !cb.kernel->interpreted ? cb.kernel->fn : nullptr,
         cb.kernel ? cb.kernel->taylor : nullptr, cb.kernel ? cb.kernel->taylor_extended : nullptr,
         cb.kernel ? cb.kernel->params : std::vector<double>(),
         y, shape.time_first(), t0, t1, eps, sicm_ode_step_type_name(T)});

@@ -311,7 +311,7 @@ std::vector<std::string> compiler_words() {
   return words;
 }
 
-const char *const kFlags[] = {"-std=c11", "-O2", "-fPIC", "-shared"};
+const char *const kFlags[] = {"-std=c11", "-O2", "-ffp-contract=off", "-fPIC", "-shared"};
 
 // kFlags and, in a sanitized build, the sanitizer flags, so that the kernels
 // a sanitized sicm loads are checked too (and cached apart from the others,

@@ -1,8 +1,9 @@
 // The JIT: C source to a loaded shared object by the system C compiler, cached by content hash.
 //
 // The compiler is $CC (split on blanks) or `cc`, run without a shell as
-//   CC -std=c11 -O2 -fPIC -shared [SANITIZER FLAGS] -o OUT.so SRC.c -lm
-// (no -ffast-math: kernels keep IEEE semantics). Objects are cached in
+//   CC -std=c11 -O2 -ffp-contract=off -fPIC -shared [SANITIZER FLAGS] -o OUT.so SRC.c -lm
+// (no -ffast-math: kernels keep IEEE semantics; no fused multiply-adds, so
+// the kernel interpreter, codegen/kernel_interpreter.hpp, gives their bits). Objects are cached in
 // $XDG_CACHE_HOME/sicm, else ~/.cache/sicm, else a private temporary
 // directory, as KEY.so where KEY is the SHA-256 of the source, the compiler
 // command and the machine, so an unchanged kernel is compiled once per

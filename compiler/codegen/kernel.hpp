@@ -36,12 +36,15 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "base/value.hpp"
 
 namespace sicm {
+
+struct InterpretedKernel; // codegen/kernel_interpreter.hpp
 
 using KernelFn = void (*)(const double *in, double *out, const double *p);
 using TaylorFn = void (*)(const double *in, int order, double *c, const double *p);
@@ -74,10 +77,17 @@ struct Kernel {
   std::string taylor_why_not;
   // The values of p[] for every function above.
   std::vector<double> params;
+  // Under SICM_INTERPRET=1 (codegen/kernel_interpreter.hpp): what fn and
+  // singular_factors run instead of loaded code (c_source is still the C
+  // they would compile, so_path empty, no Taylor functions); else null.
+  std::shared_ptr<const InterpretedKernel> interpreted;
 };
 
-// The p[] to pass to k's functions (null when it has no parameters).
+// The p[] to pass to k's functions (null when it has no parameters): the
+// numbers of k->params, or for an interpreted kernel the object its
+// functions run (not numbers: only k's functions may be given it).
 inline const double *kernel_params(const Kernel *k) {
+  if (k->interpreted) return reinterpret_cast<const double *>(k->interpreted.get());
   return k->params.empty() ? nullptr : k->params.data();
 }
 

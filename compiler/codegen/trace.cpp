@@ -25,6 +25,7 @@
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
 #include "codegen/kernel_form.hpp"
+#include "codegen/kernel_interpreter.hpp"
 #include "codegen/singular_factors.hpp"
 #include "codegen/state_shape.hpp"
 #include "eval/effect_guard.hpp"
@@ -293,9 +294,12 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   std::string taylor_name = c_name + "_taylor", taylor_why_not;
   std::string extended_name = c_name + "_taylor_extended";
   bool has_taylor = false;
-  if (options.taylor && list_length(sample_args) != 1)
+  if (options.taylor && kernels_interpreted())
+    taylor_why_not = "no Taylor coefficients under SICM_INTERPRET=1 (the kernel interpreter "
+                     "runs the derivative, not the Taylor recurrences)";
+  else if (options.taylor && list_length(sample_args) != 1)
     taylor_why_not = "it is not a system derivative (a procedure of one state)";
-  if (options.taylor && list_length(sample_args) == 1) {
+  if (options.taylor && !kernels_interpreted() && list_length(sample_args) == 1) {
     std::string taylor = emit_taylor_function(t, taylor_name, &taylor_why_not);
     std::string extended =
         emit_taylor_function(t, extended_name, &taylor_why_not, TaylorPrecision::Extended);
@@ -308,15 +312,27 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
                 taylor + "\n" + extended;
   }
   std::string so;
-  void *fn = jit_load(source, c_name, &so, why_not);
-  if (!fn) return nullptr;
-  void *probe_fn = factors.values.empty() ? nullptr : jit_load(source, probe_name, &so, why_not);
-  void *taylor_fn = has_taylor ? jit_load(source, taylor_name, &so, why_not) : nullptr;
-  void *extended_fn = has_taylor ? jit_load(source, extended_name, &so, why_not) : nullptr;
+  void *fn = nullptr, *probe_fn = nullptr, *taylor_fn = nullptr, *extended_fn = nullptr;
+  std::shared_ptr<InterpretedKernel> interpreted;
+  if (kernels_interpreted()) {
+    // The same schedules the C above prints, run by the kernel interpreter.
+    interpreted = std::make_shared<InterpretedKernel>();
+    interpreted->fn = load_kernel_program(t.outputs, t.inputs, t.param_symbols);
+    if (!factors.values.empty())
+      interpreted->singular_factors = load_kernel_program(factors.values, t.inputs, {});
+    for (Value v : t.params)
+      interpreted->params.push_back(to_double(v));
+  } else {
+    fn = jit_load(source, c_name, &so, why_not);
+    if (!fn) return nullptr;
+    probe_fn = factors.values.empty() ? nullptr : jit_load(source, probe_name, &so, why_not);
+    taylor_fn = has_taylor ? jit_load(source, taylor_name, &so, why_not) : nullptr;
+    extended_fn = has_taylor ? jit_load(source, extended_name, &so, why_not) : nullptr;
+  }
   Kernel *k = gc_new<Kernel>();
   // ignore_self: a std::string member may point into the object (its short-string buffer).
   GC_register_finalizer_ignore_self(k, finalize_kernel, nullptr, nullptr, nullptr);
-  k->fn = reinterpret_cast<KernelFn>(fn);
+  k->fn = interpreted ? interpreted_kernel_entry() : reinterpret_cast<KernelFn>(fn);
   k->nin = t.inputs.size();
   k->nout = t.outputs.size();
   k->arg_shapes = sample_args;
@@ -327,12 +343,14 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   k->c_source = std::move(source);
   k->so_path = so;
   k->singular_factors = reinterpret_cast<KernelFn>(probe_fn);
-  if (probe_fn) k->singular_texts = std::move(factors.texts);
+  if (interpreted && interpreted->singular_factors) k->singular_factors = interpreted_probe_entry();
+  if (k->singular_factors) k->singular_texts = std::move(factors.texts);
   k->taylor = reinterpret_cast<TaylorFn>(taylor_fn);
   k->taylor_extended = reinterpret_cast<TaylorExtendedFn>(extended_fn);
   k->taylor_why_not = std::move(taylor_why_not);
   for (Value v : t.params)
     k->params.push_back(to_double(v));
+  k->interpreted = std::move(interpreted);
   if (!agrees_at_sample(k, proc, sample_args, why_not)) return nullptr;
   if (g_kernel_listener) g_kernel_listener(k);
   return k;

@@ -140,7 +140,10 @@ int compile_executable(const std::string &c, const BuildOptions &o) {
   // The generated C never needs to shadow a name: a declaration that hides a
   // hoisted variable once made a built program print 0. where sicm run
   // printed the value. -Werror=shadow makes such a bug fail the build.
-  argv.insert(argv.end(), {"-std=c11", "-Werror=shadow", o.opt_level, "-o", o.output, c_path,
+  // -ffp-contract=off: no multiply and add fused into one rounding, as in
+  // sicm run's kernels, JIT'ed or interpreted (codegen/kernel_interpreter.hpp).
+  argv.insert(argv.end(), {"-std=c11", "-Werror=shadow", "-ffp-contract=off", o.opt_level, "-o",
+                           o.output, c_path,
                            "-I" + include_dir});
   argv.insert(argv.end(), mpi_flags.begin(), mpi_flags.end());
   argv.insert(argv.end(), {library, "-lsundials_cvode", "-lsundials_nvecserial", "-lgsl",
