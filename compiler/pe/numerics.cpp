@@ -512,8 +512,9 @@ std::vector<ExprId> system_outputs(const gcvec<Value> &leaves, const char *who) 
   return outputs;
 }
 
-// Every function opens with reads of the cells that set! made (read_cells,
-// pe/build_mode.cpp); a system derivative that uses none of them, beside a
+// Every function opens with reads of the cells that set! made and of the
+// lengths of lists a monitor builds (read_cells, pe/build_mode.cpp); a
+// system derivative that uses none of them, beside a
 // monitor that counts with set!, is still one DAG of its state: the reads
 // are dropped, so that it is a kernel, as in sicm run, and has Taylor
 // coefficients.
@@ -533,7 +534,8 @@ void drop_unused_cell_reads(RFunction &f) {
     }
   }
   for (const RStmt &s : f.body)
-    if (s.kind != RKind::Let || s.compute != RCompute::ReadCell ||
+    if (s.kind != RKind::Let ||
+        (s.compute != RCompute::ReadCell && s.compute != RCompute::ListLength) ||
         used.count(g_build->program.vars[s.var].sym))
       return;
   f.body.clear();
