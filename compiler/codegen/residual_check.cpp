@@ -15,40 +15,11 @@
 #include <vector>
 
 #include "base/error.hpp"
+#include "codegen/residual_dump.hpp"
 
 namespace sicm {
 
 namespace {
-
-const char *kind_name(RKind k) {
-  switch (k) {
-  case RKind::Text: return "text";
-  case RKind::Let: return "let";
-  case RKind::Print: return "print";
-  case RKind::Frame: return "frame";
-  case RKind::PlotPoint: return "plot-point";
-  case RKind::PlotLine: return "plot-line";
-  case RKind::Close: return "close";
-  case RKind::SetCell: return "set-cell";
-  case RKind::If: return "if";
-  case RKind::Loop: return "loop";
-  case RKind::Continue: return "continue";
-  case RKind::Break: return "break";
-  case RKind::Integral: return "integral";
-  case RKind::Minimize: return "minimize";
-  case RKind::Multimin: return "multimin";
-  case RKind::FindRoot: return "find-root";
-  case RKind::Bisect: return "bisect";
-  case RKind::Advance: return "advance";
-  case RKind::Evolve: return "evolve";
-  case RKind::ListNew: return "list-new";
-  case RKind::ListPush: return "list-push";
-  case RKind::ListConst: return "list-const";
-  case RKind::ParallelMap: return "parallel-map";
-  case RKind::Fail: return "fail";
-  }
-  return "unknown";
-}
 
 // The operands a Let's computation takes (codegen/residual.hpp).
 size_t compute_arity(RCompute c) {
@@ -149,7 +120,8 @@ private:
   void block(const std::vector<RStmt> &body, const std::string &path) {
     for (size_t i = 0; i < body.size(); ++i) {
       const RStmt &s = body[i];
-      std::string at = path + ": statement " + std::to_string(i) + " (" + kind_name(s.kind) + ")";
+      std::string at = path + ": statement " + std::to_string(i) + " (" +
+                       statement_kind_name(s.kind) + ")";
       where_ = at;
       statement(s, at);
     }

@@ -50,35 +50,6 @@ const char *compute_name(RCompute c) {
   return "?";
 }
 
-const char *kind_name(RKind k) {
-  switch (k) {
-  case RKind::Text: return "text";
-  case RKind::Let: return "let";
-  case RKind::Print: return "print";
-  case RKind::Frame: return "frame";
-  case RKind::PlotPoint: return "plot-point";
-  case RKind::PlotLine: return "plot-line";
-  case RKind::Close: return "graphics-close";
-  case RKind::SetCell: return "set-cell";
-  case RKind::If: return "if";
-  case RKind::Loop: return "loop";
-  case RKind::Continue: return "continue";
-  case RKind::Break: return "break";
-  case RKind::Integral: return "definite-integral";
-  case RKind::Minimize: return "minimize";
-  case RKind::Multimin: return "multidimensional-minimize";
-  case RKind::FindRoot: return "find-root";
-  case RKind::Bisect: return "bisect";
-  case RKind::Advance: return "state-advancer";
-  case RKind::Evolve: return "evolve";
-  case RKind::ListNew: return "list-new";
-  case RKind::ListPush: return "list-push";
-  case RKind::ListConst: return "list-const";
-  case RKind::ParallelMap: return "parallel-map";
-  case RKind::Fail: return "fail";
-  }
-  return "?";
-}
 
 class Dumper {
 public:
@@ -156,7 +127,7 @@ private:
         break;
       case RKind::Print: text = "print r" + std::to_string(s.var); break;
       default:
-        text = kind_name(s.kind);
+        text = statement_kind_name(s.kind);
         if (s.plot >= 0) text += " plot" + std::to_string(s.plot);
         if (s.cell >= 0) text += " cell" + std::to_string(s.cell);
         if (s.list >= 0) text += " list" + std::to_string(s.list);
@@ -191,6 +162,36 @@ private:
 };
 
 } // namespace
+
+const char *statement_kind_name(RKind k) {
+  switch (k) {
+  case RKind::Text: return "text";
+  case RKind::Let: return "let";
+  case RKind::Print: return "print";
+  case RKind::Frame: return "frame";
+  case RKind::PlotPoint: return "plot-point";
+  case RKind::PlotLine: return "plot-line";
+  case RKind::Close: return "graphics-close";
+  case RKind::SetCell: return "set-cell";
+  case RKind::If: return "if";
+  case RKind::Loop: return "loop";
+  case RKind::Continue: return "continue";
+  case RKind::Break: return "break";
+  case RKind::Integral: return "definite-integral";
+  case RKind::Minimize: return "minimize";
+  case RKind::Multimin: return "multidimensional-minimize";
+  case RKind::FindRoot: return "find-root";
+  case RKind::Bisect: return "bisect";
+  case RKind::Advance: return "state-advancer";
+  case RKind::Evolve: return "evolve";
+  case RKind::ListNew: return "list-new";
+  case RKind::ListPush: return "list-push";
+  case RKind::ListConst: return "list-const";
+  case RKind::ParallelMap: return "parallel-map";
+  case RKind::Fail: return "fail";
+  }
+  return "?";
+}
 
 std::string dump_residual(const ResidualProgram &program) {
   return Dumper(program).run();

@@ -14,4 +14,7 @@ namespace sicm {
 // "evolve f2 (r1 r2 r3) -> r7 r8 r9", ...
 std::string dump_residual(const ResidualProgram &program);
 
+// A statement kind as the dump names it ("evolve", "definite-integral").
+const char *statement_kind_name(RKind kind);
+
 } // namespace sicm

@@ -83,7 +83,7 @@ TEST_F(ResidualCheck, RejectsACalleeOutOfRange) {
 
 TEST_F(ResidualCheck, RejectsAStatementWithoutItsFields) {
   main_body()[1].args.pop_back(); // an integral over [0, ?]
-  EXPECT_NE(residual_violation(p).find("statement 1 (integral): has 1 operands, not 2"),
+  EXPECT_NE(residual_violation(p).find("statement 1 (definite-integral): has 1 operands, not 2"),
             std::string::npos)
       << residual_violation(p);
 }
