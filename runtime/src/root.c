@@ -46,6 +46,10 @@ int sicm_root_brent(double (*f)(double, void *), void *params, double a, double 
     gs = gsl_root_fsolver_iterate(s);
     if (w.bad || gs != GSL_SUCCESS) break;
     double lo = gsl_root_fsolver_x_lower(s), hi = gsl_root_fsolver_x_upper(s);
+    /* No double lies strictly inside [lo, hi] (Brent found f = 0 there, or
+     * the bracket is two neighbours): nothing finer exists. GSL's relative
+     * test alone never passes for a bracket around 0 at full precision. */
+    if (!(nextafter(lo, hi) < hi)) break;
     if (gsl_root_test_interval(lo, hi, tol, 4 * DBL_EPSILON) == GSL_SUCCESS) break;
   }
   *root = gsl_root_fsolver_root(s);
