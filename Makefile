@@ -81,13 +81,13 @@ $(BUILD)/%.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -c $< -o $@
 
-$(STDLIB_GEN): $(STDLIB_FILES) scripts/embed-stdlib
+$(STDLIB_GEN): $(STDLIB_FILES) scripts/embed-stdlib scripts/embedding.py
 	@python3 scripts/embed-stdlib $@ $(STDLIB_FILES)
 
 $(BUILD)/gen/stdlib_embed.o: $(STDLIB_GEN)
 	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -c $< -o $@
 
-$(KERNEL_SOLVE_GEN): compiler/codegen/kernel_solve.inc scripts/embed-text
+$(KERNEL_SOLVE_GEN): compiler/codegen/kernel_solve.inc scripts/embed-text scripts/embedding.py
 	@python3 scripts/embed-text $@ kKernelSolveSource $<
 
 $(BUILD)/gen/kernel_solve_text.o: $(KERNEL_SOLVE_GEN)

@@ -118,7 +118,8 @@ int main(int argc, char **argv) {
   }
 
   double sink = 0, gen[kMaxRounds], hand[kMaxRounds], ratio[kMaxRounds];
-  time_calls(GEN_KERNEL, gen_params, n / 10 + 1, y0, &sink); /* warm-up: caches, branch predictors, clock */
+  time_calls(GEN_KERNEL, gen_params, n / 10 + 1, y0,
+             &sink); /* warm-up: caches, branch predictors, clock */
   time_calls(HAND_KERNEL, NULL, n / 10 + 1, y0, &sink);
   for (int r = 0; r < rounds; r++) {
     if (r % 2 == 0) {

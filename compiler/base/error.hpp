@@ -54,7 +54,7 @@ struct Error : std::runtime_error {
   ErrorKind kind;
   ErrorCause cause = ErrorCause::Other;
   SrcLoc loc;
-  std::string note; // optional extra line (e.g. "did you mean ...")
+  std::string note;                          // optional extra line (e.g. "did you mean ...")
   bool at_top_level = raised_at_top_level(); // of a program sicm build compiles
   Error(ErrorKind k, SrcLoc l, std::string msg, std::string n = {})
       : std::runtime_error(std::move(msg)), kind(k), loc(l), note(std::move(n)) {}

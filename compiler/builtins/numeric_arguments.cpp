@@ -47,7 +47,8 @@ void check_point(Value *a, int i, const char *who) {
   for (Value x : items) {
     if (known_at_run_time_only(x)) continue;
     if (!is_number(x) || !is_real(x)) wrong_type(a[i], i + 1, who);
-    if (!std::isfinite(to_double(x))) bad_range(a[i], i + 1, who, "a point's coordinates are finite");
+    if (!std::isfinite(to_double(x)))
+      bad_range(a[i], i + 1, who, "a point's coordinates are finite");
   }
 }
 
@@ -64,19 +65,13 @@ void check_integrator(Value *a, int i, const char *who) {
 void check_argument(ArgRule rule, Value *a, int i, const char *who) {
   Value v = a[i];
   switch (rule) {
-  case R::Any:
-    return;
+  case R::Any: return;
   case R::Procedure:
     if (!is_procedure(v) && !v.is(Tag::Structure)) wrong_type(v, i + 1, who);
     return;
-  case R::Integrator:
-    check_integrator(a, i, who);
-    return;
-  case R::Point:
-    check_point(a, i, who);
-    return;
-  default:
-    break;
+  case R::Integrator: check_integrator(a, i, who); return;
+  case R::Point: check_point(a, i, who); return;
+  default: break;
   }
   // A tolerance is compiled into the program; the other numbers the
   // runtime checks when it has them.
@@ -116,8 +111,7 @@ void check_argument(ArgRule rule, Value *a, int i, const char *who) {
   case R::NonNegative:
     if (!(x >= 0) || !std::isfinite(x)) bad_range(v, i + 1, who, "a tolerance is a real >= 0");
     return;
-  default:
-    SICM_ASSERT(false);
+  default: SICM_ASSERT(false);
   }
 }
 
@@ -160,6 +154,10 @@ void check_numeric_arguments(const NumericSignature &sig, Value *a, int n, Nativ
     native_arity_error(self, n, sig.min_args, sig.max_args);
   for (int i = 0; i < n && i < static_cast<int>(sig.rules.size()); ++i)
     if (!is_missing(a, n, i)) check_argument(sig.rules[i], a, i, sig.who);
+}
+
+void check_numeric_arguments(const char *who, Value *a, int n, NativeProc *self) {
+  check_numeric_arguments(numeric_signature(who), a, n, self);
 }
 
 } // namespace sicm

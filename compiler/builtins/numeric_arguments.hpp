@@ -21,17 +21,17 @@ namespace sicm {
 struct NativeProc;
 
 enum class ArgRule {
-  Any,            // the primitive looks at it itself (a state, a flag)
-  Procedure,      // a procedure, or a structure of procedures
-  Finite,         // a finite real
-  IntervalEnd,    // a finite real other than the argument before it
-  Limit,          // a real that is not NaN, or :+infinity or :-infinity
-  Tolerance,      // a positive finite real (also a step size)
-  NonNegative,    // a finite real >= 0
-  Index,          // an exact integer >= 0
-  Count,          // an exact integer from 1 to 100000000
-  Point,          // a non-empty list or vector of finite reals
-  Integrator,     // a symbol naming an integrator (the message lists them)
+  Any,         // the primitive looks at it itself (a state, a flag)
+  Procedure,   // a procedure, or a structure of procedures
+  Finite,      // a finite real
+  IntervalEnd, // a finite real other than the argument before it
+  Limit,       // a real that is not NaN, or :+infinity or :-infinity
+  Tolerance,   // a positive finite real (also a step size)
+  NonNegative, // a finite real >= 0
+  Index,       // an exact integer >= 0
+  Count,       // an exact integer from 1 to 100000000
+  Point,       // a non-empty list or vector of finite reals
+  Integrator,  // a symbol naming an integrator (the message lists them)
 };
 
 struct NumericSignature {
@@ -55,5 +55,7 @@ const std::vector<NumericSignature> &numeric_signatures();
 // are applied. Errors are raised at current_call_loc(), the user's call.
 void check_numeric_arguments(const NumericSignature &sig, Value *a, int n,
                              NativeProc *self = nullptr);
+// The same with numeric_signature(who).
+void check_numeric_arguments(const char *who, Value *a, int n, NativeProc *self = nullptr);
 
 } // namespace sicm

@@ -116,10 +116,6 @@ double optional_real(Value *a, int n, int i, double fallback) {
   return is_missing(a, n, i) ? fallback : to_double(a[i]);
 }
 
-void check_arguments(const char *who, Value *a, int n, NativeProc *self = nullptr) {
-  check_numeric_arguments(numeric_signature(who), a, n, self);
-}
-
 std::string number_text(double x) {
   return number_to_string(Value::flonum(x));
 }
@@ -561,7 +557,7 @@ const sicm_ode_step_type *arg_integrator(Value *a, int n, int i, const char *who
                                             kIntegratorList + ")");
     return T;
   }
-  return integrator_for(symbol_name(a[i])); // a name checked by check_arguments
+  return integrator_for(symbol_name(a[i])); // a name checked by check_numeric_arguments
 }
 
 // ---- one integration problem ----------------------------------------------------
@@ -602,8 +598,9 @@ struct OdeProblem {
       probe_texts.clear();
       for (const std::string &text : cb.kernel->singular_texts)
         probe_texts.push_back(text.c_str());
-      sicm_ode_set_singularity_probe(ode.get(), cb.kernel->singular_factors, kernel_params(cb.kernel),
-                                     probe_texts.size(), probe_texts.data());
+      sicm_ode_set_singularity_probe(ode.get(), cb.kernel->singular_factors,
+                                     kernel_params(cb.kernel), probe_texts.size(),
+                                     probe_texts.data());
     }
     if (T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended) use_taylor(ode.get(), T);
     // Implicit methods solve with the Jacobian: from a kernel of (D sysder)
@@ -630,11 +627,11 @@ struct OdeProblem {
         sicm_ode_set_taylor(ode, cb.kernel->taylor, kernel_params(cb.kernel));
       return;
     }
-    std::string why =
-        !cb.kernel ? "this one is interpreted, not compiled (it cannot be traced, or "
-                     "--max-compiled-kernels was reached)"
-        : cb.kernel->taylor_why_not.empty() ? "this one was compiled without them"
-                                            : "this one has " + cb.kernel->taylor_why_not;
+    std::string why = !cb.kernel ? "this one is interpreted, not compiled (it cannot be traced, or "
+                                   "--max-compiled-kernels was reached)"
+                      : cb.kernel->taylor_why_not.empty()
+                          ? "this one was compiled without them"
+                          : "this one has " + cb.kernel->taylor_why_not;
     numeric_error(cb.loc, cb.who,
                   std::string(sicm_ode_step_type_name(T)) +
                       " needs a compiled system derivative whose operations all have Taylor "
@@ -650,8 +647,8 @@ struct OdeProblem {
         // functions the numbers of p[] (kernel_params, codegen/kernel.hpp).
         loc_text(cb.loc), who, cb.kernel && !cb.kernel->interpreted ? cb.kernel->fn : nullptr,
         cb.kernel ? cb.kernel->taylor : nullptr, cb.kernel ? cb.kernel->taylor_extended : nullptr,
-        cb.kernel ? cb.kernel->params : std::vector<double>(),
-        y, shape.time_first(), t0, t1, eps, sicm_ode_step_type_name(T)});
+        cb.kernel ? cb.kernel->params : std::vector<double>(), y, shape.time_first(), t0, t1, eps,
+        sicm_ode_step_type_name(T)});
   }
 
   // Advance the integrator to t1; errors at the call site on failure.
@@ -695,7 +692,7 @@ Value make_named_procedure(NativeFn fn, Value sysder, Lambda *lambda) {
 // dt later.
 Value advance_state(NativeProc *self, Value *a, int n) {
   static const char who[] = "state-advancer";
-  check_arguments(who, a, n, self);
+  check_numeric_arguments(who, a, n, self);
   SrcLoc loc = current_call_loc();
   double dt = real_at(a, 1);
   double eps = optional_real(a, n, 2, kAdvancerTolerance);
@@ -756,7 +753,7 @@ private:
 // time (the last interval is shortened to end there); returns the final state.
 Value run_evolve(NativeProc *self, Value *a, int n) {
   static const char who[] = "evolve";
-  check_arguments(who, a, n, self);
+  check_numeric_arguments(who, a, n, self);
   SrcLoc loc = current_call_loc();
   Value monitor = a[1];
   double dt = real_at(a, 2);
@@ -808,7 +805,7 @@ double limit_at(Value *a, int i) {
 // to b to the relative tolerance (default 1e-11), by adaptive Gauss-Kronrod.
 Value P_definite_integral(Value *a, int n) {
   static const char who[] = "definite-integral";
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
   Value f = a[0];
   double lo = limit_at(a, 1), hi = limit_at(a, 2);
@@ -847,7 +844,7 @@ Value P_definite_integral(Value *a, int n) {
 // (minimize f a b [tolerance]): Brent's method on [a, b]; the list
 // (argument value iterations), as scmutils' brent-min returns it.
 Value minimize_with(const char *who, Value *a, int n) {
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
   Value f = a[0];
   double lo = real_at(a, 1), hi = real_at(a, 2);
@@ -915,7 +912,7 @@ NelderMeadResult nelder_mead(VectorCallback &cb, std::vector<double> x, double s
 // iterations ran out.
 Value P_nelder_mead(Value *a, int n) {
   static const char who[] = "nelder-mead";
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
   Value f = a[0];
   bool is_list;
@@ -935,7 +932,7 @@ Value P_nelder_mead(Value *a, int n) {
 // by Nelder-Mead; the result has the initial point's type.
 Value P_multidimensional_minimize(Value *a, int n) {
   static const char who[] = "multidimensional-minimize";
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
   Value f = a[0];
   bool is_list;
@@ -943,12 +940,12 @@ Value P_multidimensional_minimize(Value *a, int n) {
   double tol = optional_real(a, n, 2, kNelderTolerance);
   VectorCallback cb(loc, who, f, x.size(), is_list);
   NelderMeadResult r = nelder_mead(cb, std::move(x), kNelderStep, tol, kNelderMaxIter * 20);
-  if (r.status != SICM_SUCCESS)
+  if (r.status != SICM_SUCCESS) {
+    char reason[SICM_MIN_FAILURE_BUFSIZE]; // the words built programs use (sicm/min.h)
     numeric_error(loc, who,
-                  "the minimizer did not converge in " + std::to_string(r.iterations) +
-                      " iterations (best point " +
-                      write_string(point_value(r.x.data(), r.x.size(), is_list)) + ", value " +
-                      number_text(r.fmin) + ")");
+                  sicm_min_nelder_mead_failure(reason, r.iterations, r.x.size(), r.x.data(), r.fmin,
+                                               is_list));
+  }
   return point_value(r.x.data(), r.x.size(), is_list);
 }
 
@@ -958,7 +955,7 @@ Value P_multidimensional_minimize(Value *a, int n) {
 // by Brent's method (full precision by default).
 Value P_find_root(Value *a, int n) {
   static const char who[] = "find-root";
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
   Value f = a[0];
   double lo = real_at(a, 1), hi = real_at(a, 2);
@@ -988,7 +985,7 @@ Value P_find_root(Value *a, int n) {
 // The runtime's sicm_root_bisect takes the steps, as in built programs.
 Value P_bisect(Value *a, int n) {
   static const char who[] = "bisect";
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   SrcLoc loc = current_call_loc();
   Value f = a[0];
   double x0 = real_at(a, 1), x1 = real_at(a, 2);

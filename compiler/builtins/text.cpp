@@ -226,7 +226,8 @@ Value pad(Value *args, int nargs, bool left, const char *who) {
 int64_t g_symbol_counter = 10;
 
 void install_characters() {
-  define_primitive("char?", 1, 1, Stage::Pure, [](Value *a, int) { return boolean(a[0].is(Tag::Char)); });
+  define_primitive("char?", 1, 1, Stage::Pure,
+                   [](Value *a, int) { return boolean(a[0].is(Tag::Char)); });
   define_primitive("char->integer", 1, 1, Stage::Pure,
                    [](Value *a, int) { return Value::fixnum(arg_char(a, 0, "char->integer")); });
   define_primitive("integer->char", 1, 1, Stage::Pure, [](Value *a, int) {
@@ -293,7 +294,8 @@ void install_characters() {
 }
 
 void install_strings() {
-  define_primitive("string?", 1, 1, Stage::Pure, [](Value *a, int) { return boolean(a[0].is(Tag::String)); });
+  define_primitive("string?", 1, 1, Stage::Pure,
+                   [](Value *a, int) { return boolean(a[0].is(Tag::String)); });
   define_primitive("make-string", 1, 2, Stage::Pure, [](Value *a, int n) {
     size_t k = arg_count(a, 0, "make-string");
     uint32_t fill = supplied(a, n, 1) ? arg_char(a, 1, "make-string") : ' ';
@@ -491,7 +493,8 @@ void install_strings() {
 }
 
 void install_symbols() {
-  define_primitive("symbol?", 1, 1, Stage::Pure, [](Value *a, int) { return boolean(is_symbol(a[0])); });
+  define_primitive("symbol?", 1, 1, Stage::Pure,
+                   [](Value *a, int) { return boolean(is_symbol(a[0])); });
   define_primitive("symbol->string", 1, 1, Stage::Pure,
                    [](Value *a, int) { return str(arg_symbol(a, 0, "symbol->string")->name); });
   define_primitive("string->symbol", 1, 1, Stage::Pure,

@@ -47,8 +47,9 @@ namespace {
 class Printer {
 public:
   Printer(const Schedule &s, const std::function<std::string(Symbol *)> &spell,
-          const std::string &prefix, const std::string &site)
-      : s_(s), spell_(spell), prefix_(prefix), site_(site) {}
+          const std::string &prefix, const std::string &site,
+          const std::function<std::string(ExprId)> &site_of = nullptr)
+      : s_(s), spell_(spell), prefix_(prefix), site_(site), site_of_(site_of) {}
 
   // The steps, each line starting with indent, outputs into targets.
   std::string statements(const std::vector<std::string> &targets, const std::string &indent) {
@@ -93,7 +94,9 @@ public:
              "}, (const double[]){" + list(rhs) + "}, " + t + ");");
         break;
       }
-      case StepKind::Output: line("  " + targets[step.output] + " = " + text(step.term) + ";"); break;
+      case StepKind::Output:
+        line("  " + targets[step.output] + " = " + text(step.term) + ";");
+        break;
       case StepKind::SingularCheck: {
         // A singular matrix: every output is the NaN that says so (sicm/error.h).
         std::string any;
@@ -173,21 +176,29 @@ private:
     case TermKind::Div: return binary_text(t);
     case TermKind::Call: return term.text + "(" + list(term.args) + ")";
     case TermKind::CheckedCall: {
-      std::string s = "sicm_checked_" + term.text + "(" + site_;
+      std::string s = "sicm_checked_" + term.text + "(" + site_for(term);
       for (uint32_t a : term.args)
         s += ", " + text(a);
       return s + ")";
     }
     case TermKind::CheckedQuotient:
-      return "sicm_checked_quotient(" + site_ + ", \"" + term.text + "\", " + text(term.args[0]) +
-             ", " + text(term.args[1]) + ")";
+      return "sicm_checked_quotient(" + site_for(term) + ", \"" + term.text + "\", " +
+             text(term.args[0]) + ", " + text(term.args[1]) + ")";
     }
     internal_failure(__FILE__, __LINE__, "a term without a C form");
+  }
+
+  // Where a checked term fails: the call that made its operation, when
+  // the caller knows it, else the statement's site.
+  std::string site_for(const Term &term) const {
+    std::string site = site_of_ && term.source != kNoExpr ? site_of_(term.source) : "";
+    return site.empty() ? site_ : site;
   }
 
   const Schedule &s_;
   const std::function<std::string(Symbol *)> &spell_;
   const std::string &prefix_, &site_;
+  const std::function<std::string(ExprId)> &site_of_;
 };
 
 } // namespace
@@ -293,9 +304,10 @@ std::string emit_c_assignments(const std::vector<ExprId> &values,
                                const std::vector<std::string> &targets,
                                const std::function<std::string(Symbol *)> &spell,
                                const std::string &temp_prefix, const std::string &indent,
-                               const std::string &checked_site) {
+                               const std::string &checked_site,
+                               const std::function<std::string(ExprId)> &site_of) {
   Schedule s = schedule_outputs(values, !checked_site.empty());
-  return Printer(s, spell, temp_prefix, checked_site).statements(targets, indent);
+  return Printer(s, spell, temp_prefix, checked_site, site_of).statements(targets, indent);
 }
 
 bool uses_linear_solve(const std::vector<ExprId> &outputs) {
@@ -318,7 +330,8 @@ static inline double sicm_singular_nan(void) {
   return u.d;
 }
 
-)" + kKernelSolveSource + "\n";
+)" + kKernelSolveSource +
+         "\n";
 }
 
 std::string emit_kernel_unit(const Trace &t, const std::string &c_name,

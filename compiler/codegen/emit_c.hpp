@@ -34,12 +34,15 @@ std::string emit_kernel_unit(const Trace &t, const std::string &c_name,
 // (the C text of a const sicm_site *), division, sqrt, log, asin, acos and
 // pow are the runtime's sicm_checked_ forms, which fail at that site where
 // the interpreter raises an error or leaves the reals (the residual
-// program's own arithmetic); kernels pass none.
+// program's own arithmetic); kernels pass none. site_of, when given, names
+// the site of a checked operation's node instead (the call that made it:
+// the `/` of `(/ 1 x)`, as sicm run reports it), or "" for checked_site.
 std::string emit_c_assignments(const std::vector<ExprId> &values,
                                const std::vector<std::string> &targets,
                                const std::function<std::string(Symbol *)> &spell,
                                const std::string &temp_prefix, const std::string &indent,
-                               const std::string &checked_site = "");
+                               const std::string &checked_site = "",
+                               const std::function<std::string(ExprId)> &site_of = nullptr);
 
 // Does any output depend on a solve node (algebra/linear_solve.hpp)?
 bool uses_linear_solve(const std::vector<ExprId> &outputs);

@@ -504,7 +504,7 @@ bool may_load_another(std::string *why_not) {
              " distinct procedures (--max-compiled-kernels)";
   static std::atomic<bool> told{false};
   if (!told.exchange(true)) {
-    SrcLoc loc = g_request_site.known()     ? g_request_site
+    SrcLoc loc = g_request_site.known()       ? g_request_site
                  : current_call_loc().known() ? current_call_loc()
                                               : current_toplevel_loc();
     std::fprintf(stderr,

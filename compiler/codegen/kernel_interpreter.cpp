@@ -1,4 +1,5 @@
-// The kernel interpreter: a schedule as three-address instructions over a register file (see kernel_interpreter.hpp).
+// The kernel interpreter: a schedule as three-address instructions over a register file (see
+// kernel_interpreter.hpp).
 #include "codegen/kernel_interpreter.hpp"
 
 #include <algorithm>
@@ -65,11 +66,11 @@ struct LibmFunction {
   size_t arity;
 };
 constexpr LibmFunction kLibm[] = {
-    {"sin", Code::Sin, 1},     {"cos", Code::Cos, 1},       {"tan", Code::Tan, 1},
-    {"exp", Code::Exp, 1},     {"log", Code::Log, 1},       {"sqrt", Code::Sqrt, 1},
-    {"asin", Code::Asin, 1},   {"acos", Code::Acos, 1},     {"atan", Code::Atan, 1},
-    {"sinh", Code::Sinh, 1},   {"cosh", Code::Cosh, 1},     {"fabs", Code::Fabs, 1},
-    {"atan2", Code::Atan2, 2}, {"pow", Code::Pow, 2},       {"copysign", Code::Copysign, 2},
+    {"sin", Code::Sin, 1},     {"cos", Code::Cos, 1},   {"tan", Code::Tan, 1},
+    {"exp", Code::Exp, 1},     {"log", Code::Log, 1},   {"sqrt", Code::Sqrt, 1},
+    {"asin", Code::Asin, 1},   {"acos", Code::Acos, 1}, {"atan", Code::Atan, 1},
+    {"sinh", Code::Sinh, 1},   {"cosh", Code::Cosh, 1}, {"fabs", Code::Fabs, 1},
+    {"atan2", Code::Atan2, 2}, {"pow", Code::Pow, 2},   {"copysign", Code::Copysign, 2},
 };
 
 constexpr uint32_t kNone = UINT32_MAX;

@@ -1,4 +1,5 @@
-// The kernel interpreter: a kernel's schedule run on doubles, operation for operation as its C runs, for SICM_INTERPRET=1 (no C compiler, no JIT).
+// The kernel interpreter: a kernel's schedule run on doubles, operation for operation as its C
+// runs, for SICM_INTERPRET=1 (no C compiler, no JIT).
 //
 // Requires: the schedule the C emitter prints (codegen/schedule.hpp) of
 // unchecked outputs (a kernel's, not a residual program's). Produces:

@@ -25,6 +25,7 @@
 
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "base/srcloc.hpp"
@@ -117,6 +118,7 @@ struct RStmt {
   int list = -1;            // ListNew, ListPush, Let of ListLength, ListRef, ListFold
   int leaf = 0;             // Let of ListRef, ListFold; ListConst: the table
   bool backward = false;    // Let of ListFold
+  bool as_list = false;     // Multimin: the start point is a list (not a vector), for messages
   double number = 0;        // a tolerance
   bool time_first = false, rate_one = false; // Advance, Evolve
   std::string method;                        // Advance, Evolve: the runtime's step type variable
@@ -168,6 +170,10 @@ struct RTable {
 };
 
 struct ResidualProgram {
+  // The call that made each division, root, logarithm and power of run-time
+  // values (pe/build_mode.cpp): where the executable reports it failing, as
+  // sicm run does, rather than at the statement that computes it.
+  std::unordered_map<ExprId, SrcLoc> op_sites;
   std::vector<RFunction> functions; // [0] is main
   std::vector<RVar> vars;
   std::vector<RCell> cells;

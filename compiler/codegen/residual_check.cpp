@@ -120,8 +120,8 @@ private:
   void block(const std::vector<RStmt> &body, const std::string &path) {
     for (size_t i = 0; i < body.size(); ++i) {
       const RStmt &s = body[i];
-      std::string at = path + ": statement " + std::to_string(i) + " (" +
-                       statement_kind_name(s.kind) + ")";
+      std::string at =
+          path + ": statement " + std::to_string(i) + " (" + statement_kind_name(s.kind) + ")";
       where_ = at;
       statement(s, at);
     }
@@ -130,8 +130,8 @@ private:
   void define(int v, const char *as) {
     require(var_ok(v), std::string(as) + " r" + std::to_string(v) + " is not a variable");
     const RVar &var = p_.vars[static_cast<size_t>(v)];
-    require(var.function == f_, std::string(as) + " r" + std::to_string(v) +
-                                    " belongs to f" + std::to_string(var.function));
+    require(var.function == f_, std::string(as) + " r" + std::to_string(v) + " belongs to f" +
+                                    std::to_string(var.function));
     require(defs_[static_cast<size_t>(v)]++ == 0, "r" + std::to_string(v) + " is defined twice");
     defined_[static_cast<size_t>(v)] = true;
   }
@@ -145,12 +145,12 @@ private:
   void use_var(int v) {
     const RVar &var = p_.vars[static_cast<size_t>(v)];
     if (var.function == f_) {
-      require(defined_[static_cast<size_t>(v)], "r" + std::to_string(v) +
-                                                    " is used before it is defined");
+      require(defined_[static_cast<size_t>(v)],
+              "r" + std::to_string(v) + " is used before it is defined");
     } else if (is_ancestor(var.function, f_)) {
-      require(defs_[static_cast<size_t>(v)] > 0,
-              "r" + std::to_string(v) + " of f" + std::to_string(var.function) +
-                  " is captured but never defined");
+      require(defs_[static_cast<size_t>(v)] > 0, "r" + std::to_string(v) + " of f" +
+                                                     std::to_string(var.function) +
+                                                     " is captured but never defined");
     }
     // A variable of a function that does not enclose this one is the
     // emitter's compile error (a value that escapes its procedure).
@@ -170,8 +170,8 @@ private:
   }
 
   void args(const RStmt &s, size_t n) {
-    require(s.args.size() == n, "has " + std::to_string(s.args.size()) + " operands, not " +
-                                    std::to_string(n));
+    require(s.args.size() == n,
+            "has " + std::to_string(s.args.size()) + " operands, not " + std::to_string(n));
   }
   void outs(const RStmt &s, size_t n) {
     require(s.outs.size() == n,
@@ -206,8 +206,7 @@ private:
   // The fields the statement's kind needs (codegen/residual.hpp), its
   // operands' variables, then what it defines.
   void statement(const RStmt &s, const std::string &at) {
-    if (s.kind != RKind::If && s.kind != RKind::Loop)
-      require(s.then_body.empty(), "has a body");
+    if (s.kind != RKind::If && s.kind != RKind::Loop) require(s.then_body.empty(), "has a body");
     if (s.kind != RKind::If) require(s.else_body.empty(), "has an else body");
     for (ExprId a : s.args)
       uses(a);

@@ -50,7 +50,6 @@ const char *compute_name(RCompute c) {
   return "?";
 }
 
-
 class Dumper {
 public:
   explicit Dumper(const ResidualProgram &p) : p_(p) {

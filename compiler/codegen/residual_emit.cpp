@@ -359,6 +359,15 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     return "&" + name;
   }
 
+  // The site of the call that made operation node e, made once; "" if none.
+  std::string op_site(ExprId e) {
+    auto made = p_.op_sites.find(e);
+    if (made == p_.op_sites.end()) return "";
+    auto named = op_site_names_.find(e);
+    if (named != op_site_names_.end()) return named->second;
+    return op_site_names_[e] = site(made->second);
+  }
+
   std::string spell(Symbol *s) {
     int v = var_id(s);
     SICM_ASSERT(v >= 0); // refs_of checked every symbol
@@ -373,7 +382,8 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
                                   const std::string &temp_prefix, const SrcLoc &loc) {
     static const std::string kPlaceholder = "sicm_checked_site_placeholder";
     std::string code = emit_c_assignments(
-        values, targets, [this](Symbol *s) { return spell(s); }, temp_prefix, "", kPlaceholder);
+        values, targets, [this](Symbol *s) { return spell(s); }, temp_prefix, "", kPlaceholder,
+        [this](ExprId e) { return op_site(e); });
     size_t at = code.find(kPlaceholder);
     if (at == std::string::npos) return code;
     std::string where = site(loc);
@@ -574,8 +584,8 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
             (s.title.empty() ? std::string("NULL") : c_string_literal(s.title)) + ", " + a[0] +
             ", " + a[1] + ", " + a[2] + ", " + a[3] + ");\n";
     if (!s.axis_labels.empty())
-      code += "sicm_program_plot_labels(" + site(s.loc) + ", plot" + std::to_string(s.plot) +
-              ", " + c_string_literal(s.axis_labels[0]) + ", " +
+      code += "sicm_program_plot_labels(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
+              c_string_literal(s.axis_labels[0]) + ", " +
               (s.axis_labels.size() > 1 ? c_string_literal(s.axis_labels[1]) : "NULL") + ");\n";
     return code;
   }
@@ -643,8 +653,8 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
   std::string bisect(int f, const RStmt &s, const std::string &prefix) {
     std::string code;
     std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
-    std::string call = "sicm_drive_bisect(" + site(s.loc) + ", " + closure(s.callee) + ", " +
-                       a[0] + ", " + a[1] + ", " + a[2] + ", " +
+    std::string call = "sicm_drive_bisect(" + site(s.loc) + ", " + closure(s.callee) + ", " + a[0] +
+                       ", " + a[1] + ", " + a[2] + ", " +
                        std::to_string(static_cast<long>(s.number)) + ")";
     return code + single_result(f, s, call);
   }
@@ -665,7 +675,8 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     std::string x = prefix + "x";
     code += "double " + x + "[] = {" + join(a) + "};\n";
     code += "sicm_drive_multimin(" + site(s.loc) + ", " + closure(s.callee) + ", " +
-            std::to_string(a.size()) + ", " + x + ", " + c_double_literal(s.number) + ");\n";
+            std::to_string(a.size()) + ", " + x + ", " + c_double_literal(s.number) + ", " +
+            (s.as_list ? "1" : "0") + ");\n";
     code += unpack(f, s.outs, x);
     return code;
   }
@@ -680,8 +691,8 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     std::string y = prefix + "y";
     code += "double " + y + "[] = {" + join({a.begin(), a.begin() + dim}) + "};\n";
     if (s.kind == RKind::Advance)
-      code += "sicm_drive_advance(" + site(s.loc) + ", &" + ode(s, dim) + ", " + y + ", " +
-              a[dim] + ");\n";
+      code += "sicm_drive_advance(" + site(s.loc) + ", &" + ode(s, dim) + ", " + y + ", " + a[dim] +
+              ");\n";
     else
       code += "sicm_drive_evolve(" + site(s.loc) + ", &" + ode(s, dim) + ", " +
               closure(s.first_monitor >= 0 ? s.first_monitor : s.monitor) + ", " +
@@ -875,6 +886,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
   int nstatements_ = 0;
   std::map<Symbol *, int> var_ids_;
   std::string sites_;
+  std::map<ExprId, std::string> op_site_names_;
   int nsites_ = 0;
   int nprobes_ = 0;
   std::set<std::string> taylor_names_;

@@ -1,4 +1,5 @@
-// The scheduler: CSE by use counts, powers as products, sincos pairs, linear solves (see schedule.hpp).
+// The scheduler: CSE by use counts, powers as products, sincos pairs, linear solves (see
+// schedule.hpp).
 //
 // The outputs form a DAG in the expression arena, already shared by
 // hash-consing. The scheduler walks the nodes reachable from the outputs
@@ -325,6 +326,7 @@ private:
     Term t{kind};
     t.text = std::move(fn);
     t.args = std::move(args);
+    if (kind == TermKind::CheckedCall || kind == TermKind::CheckedQuotient) t.source = inlining_;
     return add(std::move(t));
   }
 
@@ -607,6 +609,12 @@ private:
 
   // An operation node written out in full (its arguments by ref).
   uint32_t inline_form(ExprId id) {
+    // The node being written out, for the checked terms it makes.
+    struct Inlining {
+      ExprId &current, outer;
+      Inlining(ExprId &c, ExprId id) : current(c), outer(c) { current = id; }
+      ~Inlining() { current = outer; }
+    } inlining(inlining_, id);
     if (zeros_.count(id)) return literal(0.0); // see find_exact_zeros
     Op op = expr_node(id).op;
     std::vector<ExprId> args = expr_arg_vector(id);
@@ -657,12 +665,13 @@ private:
 
   std::vector<ExprId> outputs_;
   bool checked_;
+  ExprId inlining_ = kNoExpr; // the node inline_form is writing out
   std::vector<ExprId> nodes_; // reachable from the outputs, increasing ids
   std::unordered_map<ExprId, uint32_t> uses_;
   std::unordered_set<ExprId> wants_name_;
-  std::unordered_set<ExprId> zeros_;           // see find_exact_zeros
-  std::unordered_map<ExprId, ExprId> partner_; // sin node <-> cos node of one argument
-  std::unordered_map<ExprId, uint32_t> name_;  // node -> its Temp or Element term
+  std::unordered_set<ExprId> zeros_;                       // see find_exact_zeros
+  std::unordered_map<ExprId, ExprId> partner_;             // sin node <-> cos node of one argument
+  std::unordered_map<ExprId, uint32_t> name_;              // node -> its Temp or Element term
   std::map<std::pair<ExprId, uint64_t>, uint32_t> powers_; // (base, m) -> a term of base^m
   std::map<std::vector<ExprId>, Factors> factors_;         // matrix entries -> factors
   std::map<std::vector<ExprId>, uint32_t> solutions_;      // matrix and rhs -> solution array

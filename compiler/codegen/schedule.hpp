@@ -1,4 +1,5 @@
-// The schedule of a kernel: its outputs as a straight-line list of steps over expression trees of doubles, which the C emitter prints and the kernel interpreter runs.
+// The schedule of a kernel: its outputs as a straight-line list of steps over expression trees of
+// doubles, which the C emitter prints and the kernel interpreter runs.
 //
 // Requires: outputs over symbols with only numbers, symbols, ops.def
 // applications and solve nodes (a Trace's, or a residual program's
@@ -45,12 +46,13 @@ struct Term {
   explicit Term(TermKind k) : kind(k) {}
   TermKind kind;
   int prec = kAtom;
-  double value = 0;          // Literal
-  std::string text;          // Literal: its C spelling; calls: the function; CheckedQuotient: who
-  Symbol *symbol = nullptr;  // Symbol
-  uint32_t temp = 0;         // Temp, Element
-  uint32_t element = 0;      // Element
+  double value = 0;           // Literal
+  std::string text;           // Literal: its C spelling; calls: the function; CheckedQuotient: who
+  Symbol *symbol = nullptr;   // Symbol
+  uint32_t temp = 0;          // Temp, Element
+  uint32_t element = 0;       // Element
   std::vector<uint32_t> args; // terms with smaller indices
+  ExprId source = kNoExpr;    // checked terms: the operation node they compute (its site)
 };
 
 enum class StepKind : uint8_t {
@@ -60,7 +62,7 @@ enum class StepKind : uint8_t {
   Solve,            // double temp[n] = {terms}; solved with the factors in temp2
   SolveInterpreted, // double temp[n] solves (terms: n * n matrix, n rhs) as the interpreter does
   Output,           // target `output` = term
-  SingularCheck,    // if any factorization in `flags` was singular, every output is the singular NaN
+  SingularCheck, // if any factorization in `flags` was singular, every output is the singular NaN
 };
 
 struct Step {

@@ -143,8 +143,7 @@ int compile_executable(const std::string &c, const BuildOptions &o) {
   // -ffp-contract=off: no multiply and add fused into one rounding, as in
   // sicm run's kernels, JIT'ed or interpreted (codegen/kernel_interpreter.hpp).
   argv.insert(argv.end(), {"-std=c11", "-Werror=shadow", "-ffp-contract=off", o.opt_level, "-o",
-                           o.output, c_path,
-                           "-I" + include_dir});
+                           o.output, c_path, "-I" + include_dir});
   argv.insert(argv.end(), mpi_flags.begin(), mpi_flags.end());
   argv.insert(argv.end(), {library, "-lsundials_cvode", "-lsundials_nvecserial", "-lgsl",
                            "-lgslcblas", "-lm", "-lpthread"});

@@ -31,8 +31,8 @@ void log_assignment(const Assignment &a) {
 // lists are read again)?
 bool block_calls(const std::vector<RStmt> &block) {
   for (const RStmt &s : block)
-    if (s.callee >= 0 || s.monitor >= 0 || s.first_monitor >= 0 || !s.members.empty() || s.kind == RKind::ListPush ||
-        block_calls(s.then_body) || block_calls(s.else_body))
+    if (s.callee >= 0 || s.monitor >= 0 || s.first_monitor >= 0 || !s.members.empty() ||
+        s.kind == RKind::ListPush || block_calls(s.then_body) || block_calls(s.else_body))
       return true;
   return false;
 }

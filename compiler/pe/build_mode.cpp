@@ -653,6 +653,22 @@ template <const char *Name> Value P_identity_on_dynamic(Value *a, int n) {
   if (is_dynamic_scalar(a[0])) return a[0];
   return call_original(Name, a, n);
 }
+// Division, roots, logarithms and powers of run-time values remember the
+// call that made them (ResidualProgram::op_sites): the executable reports
+// a division by zero at the `/`, as sicm run does, not at the statement
+// that computes the expression it is in.
+template <const char *Name> Value P_located(Value *a, int n) {
+  Value r = call_original(Name, a, n);
+  if (is_dynamic_scalar(r)) g_build->program.op_sites.emplace(expr_of(r, Name), current_call_loc());
+  return r;
+}
+constexpr char kDivide[] = "/";
+constexpr char kSqrt[] = "sqrt";
+constexpr char kLog[] = "log";
+constexpr char kAsin[] = "asin";
+constexpr char kAcos[] = "acos";
+constexpr char kExpt[] = "expt";
+
 constexpr char kExactToInexact[] = "exact->inexact";
 constexpr char kInexact[] = "inexact";
 
@@ -692,6 +708,8 @@ const PrimFn p_number_p = P_number_test<kNumberP>, p_real_p = P_number_test<kRea
              p_exact_integer_p = P_number_test<kExactIntegerP>,
              p_exact_nonnegative_integer_p = P_number_test<kExactNonnegP>,
              p_exact_rational_p = P_number_test<kExactRationalP>;
+const PrimFn p_divide = P_located<kDivide>, p_sqrt = P_located<kSqrt>, p_log = P_located<kLog>,
+             p_asin = P_located<kAsin>, p_acos = P_located<kAcos>, p_expt = P_located<kExpt>;
 const PrimFn p_exact_to_inexact = P_identity_on_dynamic<kExactToInexact>,
              p_inexact = P_identity_on_dynamic<kInexact>;
 

@@ -118,9 +118,9 @@ Value kernel_input_like(Value sample) {
 // caller was in when the trace began (an index into g_build->blocks, whose
 // entry may be null for the function's body).
 struct ParameterSite {
-  int traced;           // the traced function; its vars and those of functions after it are its own
-  int parent;           // the function that calls it
-  size_t block;         // g_build->blocks.size() before the trace's function opened
+  int traced;   // the traced function; its vars and those of functions after it are its own
+  int parent;   // the function that calls it
+  size_t block; // g_build->blocks.size() before the trace's function opened
   std::unordered_set<int> parameters;        // the variables define_parameter made
   std::unordered_map<ExprId, bool> captured; // memo of is_captured
 };
@@ -139,7 +139,8 @@ bool only_outer_variables(ExprId root, ParameterSite &site) {
   const ExprNode &n = expr_node(root);
   if (n.kind == ExprKind::Symbol) {
     auto v = g_build->var_ids.find(n.sym);
-    outer = v != g_build->var_ids.end() && g_build->program.vars[v->second].function < site.traced &&
+    outer = v != g_build->var_ids.end() &&
+            g_build->program.vars[v->second].function < site.traced &&
             !site.parameters.count(v->second);
   } else if (n.kind == ExprKind::Apply || n.kind == ExprKind::Call) {
     for (ExprId a : expr_arg_vector(root))
@@ -163,8 +164,9 @@ void define_parameter(Symbol *sym, Value value) {
   g_build->program.vars.push_back(RVar{sym, RType::Real, id, site.parent});
   g_build->var_ids[sym] = id;
   site.parameters.insert(id);
-  g_build->parameter_values[expr_symbol(sym)] =
-      value.is(Tag::Flonum) ? expr_from_number(decimal_rational(value.d)) : expr_of(value, "kernel");
+  g_build->parameter_values[expr_symbol(sym)] = value.is(Tag::Flonum)
+                                                    ? expr_from_number(decimal_rational(value.d))
+                                                    : expr_of(value, "kernel");
   RStmt s{RKind::Let};
   s.loc = here();
   s.compute = RCompute::Expr;
@@ -301,15 +303,12 @@ ExprId limit_expr(Value v, const char *who) {
   return expr_of(v, who);
 }
 
-// Every primitive here first checks its arguments as sicm run's does
-// (builtins/numeric_arguments.hpp), with the same messages.
-void check_arguments(const char *who, Value *a, int n, NativeProc *self = nullptr) {
-  check_numeric_arguments(numeric_signature(who), a, n, self);
-}
-
+// Each primitive first checks its arguments with sicm run's function
+// (check_numeric_arguments, builtins/numeric_arguments.hpp): the same
+// mistake gets the same message in both modes.
 Value P_definite_integral(Value *a, int n) {
   static const char who[] = "definite-integral";
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   if (is_number(a[1]) && is_number(a[2]) && to_double(a[1]) == to_double(a[2]))
     return Value::fixnum(0); // as the interpreter: an exact 0 over an empty interval
   RStmt s{RKind::Integral};
@@ -324,7 +323,7 @@ Value P_definite_integral(Value *a, int n) {
 }
 
 template <const char *Name> Value P_minimize(Value *a, int n) {
-  check_arguments(Name, a, n);
+  check_numeric_arguments(Name, a, n);
   RStmt s{RKind::Minimize};
   s.loc = here();
   s.args = {expr_of(a[1], Name), expr_of(a[2], Name)};
@@ -340,7 +339,7 @@ constexpr char kBrentMin[] = "brent-min";
 
 Value P_multidimensional_minimize(Value *a, int n) {
   static const char who[] = "multidimensional-minimize";
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   bool is_list = !a[1].is(Tag::Vector);
   gcvec<Value> start;
   if (is_list) {
@@ -350,6 +349,7 @@ Value P_multidimensional_minimize(Value *a, int n) {
     start.assign(v->items, v->items + v->len);
   }
   RStmt s{RKind::Multimin};
+  s.as_list = is_list;
   s.loc = here();
   for (Value x : start)
     s.args.push_back(expr_of(x, who));
@@ -390,7 +390,7 @@ Value P_multidimensional_minimize(Value *a, int n) {
 
 Value P_find_root(Value *a, int n) {
   static const char who[] = "find-root";
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   RStmt s{RKind::FindRoot};
   s.loc = here();
   s.args = {expr_of(a[1], who), expr_of(a[2], who)};
@@ -404,7 +404,7 @@ Value P_find_root(Value *a, int n) {
 
 Value bisect_at_run_time(Value *a, int n) {
   static const char who[] = "bisect";
-  check_arguments(who, a, n);
+  check_numeric_arguments(who, a, n);
   RStmt s{RKind::Bisect};
   s.loc = here();
   s.args = {expr_of(a[1], who), expr_of(a[2], who), expr_of(a[3], who)};
@@ -541,6 +541,14 @@ void drop_unused_cell_reads(RFunction &f) {
   f.body.clear();
 }
 
+// A traced system derivative, Jacobian or singular-factor function that is
+// one DAG of its inputs is a kernel (RFunction::kernel): plain C, as sicm
+// run's JIT kernels.
+void mark_if_kernel(RFunction &f) {
+  drop_unused_cell_reads(f);
+  f.kernel = f.body.empty();
+}
+
 } // namespace
 
 // A system derivative traced into a new function of the state's leaves
@@ -560,8 +568,7 @@ int trace_system_function(Value sysder, Value state, const char *who) {
                                describe(state));
   std::vector<ExprId> outputs = system_outputs(leaves, who);
   current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
-  drop_unused_cell_reads(current());
-  current().kernel = current().body.empty();
+  mark_if_kernel(current());
   return scope.id();
 }
 
@@ -629,8 +636,7 @@ void trace_singular_factors(Value state, RStmt &s) {
   for (int v : current().inputs)
     to.push_back(g_build->program.vars[v].sym);
   current().outputs = with_inputs(factors.values, from, to);
-  drop_unused_cell_reads(current());
-  current().kernel = current().body.empty();
+  mark_if_kernel(current());
   s.probe = scope.id();
   s.probe_texts = std::move(factors.texts);
 }
@@ -654,8 +660,7 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
     if (leaves.size() != n * n) return;
     std::vector<ExprId> outputs = system_outputs(leaves, "jacobian");
     current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
-    drop_unused_cell_reads(current());
-    current().kernel = current().body.empty();
+    mark_if_kernel(current());
     s.jacobian = scope.id();
   } catch (const Error &) {
     parameters.rollback();
@@ -701,7 +706,7 @@ Value sysder_of(Value *a, int n, const char *who) {
 
 Value advance(NativeProc *self, Value *a, int n) {
   static const char who[] = "state-advancer";
-  check_arguments(who, a, n, self);
+  check_numeric_arguments(who, a, n, self);
   RStmt s{RKind::Advance};
   s.loc = here();
   s.number = static_number(a, n, 2, kAdvancerTolerance, who);
@@ -724,7 +729,7 @@ Value P_state_advancer(Value *a, int n) {
 
 Value run_evolve(NativeProc *self, Value *a, int n) {
   static const char who[] = "evolve";
-  check_arguments(who, a, n, self);
+  check_numeric_arguments(who, a, n, self);
   Checkpoint before; // for a monitor whose trace fails (below)
   RStmt s{RKind::Evolve};
   s.loc = here();

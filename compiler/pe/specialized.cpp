@@ -54,6 +54,14 @@ const std::vector<Specialization> &specializations() {
       {"exact-rational?", 1, 1, p_exact_rational_p},
       {"exact->inexact", 1, 1, p_exact_to_inexact},
       {"inexact", 1, 1, p_inexact},
+      // Operations that can fail at run time remember where they were
+      // called, for the executable's message.
+      {"/", 1, kVariadic, p_divide},
+      {"sqrt", 1, 1, p_sqrt},
+      {"log", 1, 1, p_log},
+      {"asin", 1, 1, p_asin},
+      {"acos", 1, 1, p_acos},
+      {"expt", 2, 2, p_expt},
 
       // The numerical primitives record a statement and return run-time
       // values; their procedures are traced into functions (pe/numerics.cpp).

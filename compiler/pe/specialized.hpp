@@ -44,6 +44,7 @@ extern const PrimFn p_random, p_real_time, p_parameter, p_runtime;
 extern const PrimFn p_number_p, p_real_p, p_inexact_p, p_exact_p, p_integer_p, p_exact_integer_p,
     p_exact_nonnegative_integer_p, p_exact_rational_p;
 extern const PrimFn p_exact_to_inexact, p_inexact;
+extern const PrimFn p_divide, p_sqrt, p_log, p_asin, p_acos, p_expt;
 
 // ---- pe/numerics.cpp: the numerical primitives record statements ------------------------
 extern const PrimFn p_definite_integral, p_minimize, p_brent_min, p_multidimensional_minimize,

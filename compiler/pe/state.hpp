@@ -199,11 +199,11 @@ public:
 
 private:
   size_t nfunctions_, nvars_, nlists_, ntables_;
-  int function_;             // the current function, or -1
-  size_t nbody_;             // its statements then
+  int function_;              // the current function, or -1
+  size_t nbody_;              // its statements then
   std::vector<RStmt> *block_; // the current block when it is not the body, or null
-  size_t nblock_;            // its statements then
-  gcvec<Value> list_places_; // the list cells' variables then
+  size_t nblock_;             // its statements then
+  gcvec<Value> list_places_;  // the list cells' variables then
 };
 // Is e cannot_compile's error?
 bool is_cannot_compile(const Error &e);

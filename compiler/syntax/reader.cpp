@@ -156,7 +156,7 @@ Value Reader::read_list(char close, SrcLoc open) {
     int c = peek();
     if (c == EOF)
       incomplete_input(open, std::string("unbalanced parentheses: this '") +
-                             (close == ')' ? '(' : '[') + "' is never closed");
+                                 (close == ')' ? '(' : '[') + "' is never closed");
     if (c == ')' || c == ']') {
       if (c != close)
         syntax_error(here(), std::string("mismatched brackets: expected '") + close + "'");

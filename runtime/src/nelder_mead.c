@@ -179,3 +179,25 @@ done:
   free(work);
   return status;
 }
+
+char *sicm_min_nelder_mead_failure(char *buf, int iterations, size_t n, const double *x,
+                                   double fmin, int as_list) {
+  const size_t size = SICM_MIN_FAILURE_BUFSIZE;
+  /* Room kept for the "...", the value and the closing text. */
+  const size_t point_room = size - 3 * SICM_DOUBLE_BUFSIZE;
+  char number[SICM_DOUBLE_BUFSIZE];
+  size_t used =
+      (size_t)snprintf(buf, size, "the minimizer did not converge in %d iterations (best point %s",
+                       iterations, as_list ? "(" : "#(");
+  for (size_t i = 0; i < n; ++i) {
+    sicm_format_double(number, x[i]);
+    if (used + strlen(number) + 1 >= point_room) {
+      used += (size_t)snprintf(buf + used, size - used, " ...");
+      break;
+    }
+    used += (size_t)snprintf(buf + used, size - used, "%s%s", i ? " " : "", number);
+  }
+  sicm_format_double(number, fmin);
+  snprintf(buf + used, size - used, "), value %s)", number);
+  return buf;
+}

@@ -390,7 +390,8 @@ void sicm_drive_minimize(const sicm_site *site, sicm_closure f, double a, double
   out[2] = iterations;
 }
 
-void sicm_drive_multimin(const sicm_site *site, sicm_closure f, size_t n, double *x, double tol) {
+void sicm_drive_multimin(const sicm_site *site, sicm_closure f, size_t n, double *x, double tol,
+                         int as_list) {
   enum { kMaxIterations = 20000 }; /* the interpreter's 20 * nelder-maxiter */
   const double start_step = 0.01;  /* nelder-start-step */
   double fmin = 0;
@@ -398,8 +399,8 @@ void sicm_drive_multimin(const sicm_site *site, sicm_closure f, size_t n, double
   int status = sicm_min_nelder_mead(vector_of, &f, n, x, start_step, tol, kMaxIterations, &fmin,
                                     &iterations);
   if (status == SICM_EMAXITER) {
-    char reason[256];
-    snprintf(reason, sizeof reason, "the minimizer did not converge in %d iterations", iterations);
+    char reason[SICM_MIN_FAILURE_BUFSIZE];
+    sicm_min_nelder_mead_failure(reason, iterations, n, x, fmin, as_list);
     sicm_program_fail(site, "multidimensional-minimize", reason);
   }
   if (status != SICM_SUCCESS) fail_with_status(site, "multidimensional-minimize");
@@ -555,8 +556,7 @@ void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double
 }
 
 void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure first,
-                       sicm_closure monitor,
-                       double *y, double dt, double t_final) {
+                       sicm_closure monitor, double *y, double dt, double t_final) {
   static const char who[] = "evolve";
   const double t0 = start_time(ode, y);
   if (first.fn) first.fn(y, NULL, first.p);

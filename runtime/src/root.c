@@ -19,8 +19,7 @@ int sicm_root_brent(double (*f)(double, void *), void *params, double a, double 
     return sicm_error(SICM_EINVAL, "%s: the tolerance %g must be non-negative", who, tol);
   fn1 w = {f, params, 0, 0, 0};
   double fa = call1(a, &w), fb = call1(b, &w);
-  if (w.bad)
-    return fn1_nonfinite(who, &w);
+  if (w.bad) return fn1_nonfinite(who, &w);
   if (fa == 0 || fb == 0) {
     *root = fa == 0 ? a : b;
     return SICM_SUCCESS;
@@ -55,8 +54,7 @@ int sicm_root_brent(double (*f)(double, void *), void *params, double a, double 
   *root = gsl_root_fsolver_root(s);
   gsl_root_fsolver_free(s);
   gsl_set_error_handler(old);
-  if (w.bad)
-    return fn1_nonfinite(who, &w);
+  if (w.bad) return fn1_nonfinite(who, &w);
   if (gs == GSL_EMAXITER)
     return sicm_error(SICM_EMAXITER, "%s: no convergence in %d iterations; best estimate %.17g",
                       who, kMaxIter, *root);

@@ -1,4 +1,5 @@
-// Unit tests of the kernel interpreter: the bits of its results against the JIT'ed C of the same trace.
+// Unit tests of the kernel interpreter: the bits of its results against the JIT'ed C of the same
+// trace.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -92,11 +93,11 @@ TEST(KernelInterpreter, PowersAndSinCosAsTheC) {
 // Matrices of more than two rows of run-time values are factored
 // (algebra/linear_solve.hpp): LDL^T when symmetric, else LU.
 TEST(KernelInterpreter, SymmetricSolveAsTheC) {
-  std::string c = expect_same_bits(
-      "(lambda (s) (let ((x (ref s 0)) (y (ref s 1)) (z (ref s 2))) "
-      "(/ (up (sin x) y (* z z)) (matrix-by-rows (list (+ 3 (* x x)) (cos y) z) "
-      "(list (cos y) (+ 4 (* y y)) x) (list z x (+ 5 (* z z)))))))",
-      "(up .4 .9 -.3)", 20000);
+  std::string c =
+      expect_same_bits("(lambda (s) (let ((x (ref s 0)) (y (ref s 1)) (z (ref s 2))) "
+                       "(/ (up (sin x) y (* z z)) (matrix-by-rows (list (+ 3 (* x x)) (cos y) z) "
+                       "(list (cos y) (+ 4 (* y y)) x) (list z x (+ 5 (* z z)))))))",
+                       "(up .4 .9 -.3)", 20000);
   EXPECT_NE(c.find("sicm_ldlt_solve("), std::string::npos);
 }
 

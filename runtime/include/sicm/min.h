@@ -46,8 +46,8 @@ int sicm_min_brent(double (*f)(double, void *), void *params, double a, double b
  * does, when the values at its vertices agree to tol relative to their size
  * (f_worst - f_best <= tol (|f_best| + |f_worst|) / 2), and fails with
  * SICM_EMAXITER after max_iter (> 0) iterations, or earlier when the
- * simplex runs off to infinity (f has no minimum near the start). The minimum's value is stored in *fmin and the
- * number of iterations in *iterations (both may be NULL).
+ * simplex runs off to infinity (f has no minimum near the start). The minimum's value is stored in
+ * *fmin and the number of iterations in *iterations (both may be NULL).
  *
  * Nelder-Mead needs no derivatives and tolerates noise, but it converges
  * slowly and can stall on a non-minimum in rare cases; restarting from the
@@ -58,6 +58,16 @@ int sicm_min_brent(double (*f)(double, void *), void *params, double a, double b
  * SICM_EMAXITER (x then holds the best point so far). */
 int sicm_min_nelder_mead(double (*f)(const double *x, void *), void *params, size_t n, double *x,
                          double step, double tol, int max_iter, double *fmin, int *iterations);
+
+/* sicm_min_nelder_mead_failure writes into buf (SICM_MIN_FAILURE_BUFSIZE
+ * bytes) why a minimization ended without converging, as
+ * multidimensional-minimize says it in sicm run and in built programs
+ * alike: "the minimizer did not converge in N iterations (best point
+ * (x0 x1 ...), value f)", the point a list, or a vector "#(x0 x1 ...)" when
+ * as_list is 0 (a point too long for the buffer ends in "..."). Returns buf. */
+#define SICM_MIN_FAILURE_BUFSIZE 4096
+char *sicm_min_nelder_mead_failure(char *buf, int iterations, size_t n, const double *x,
+                                   double fmin, int as_list);
 
 #ifdef __cplusplus
 }

@@ -135,7 +135,8 @@ void sicm_drive_minimize(const sicm_site *site, sicm_closure f, double a, double
 
 /* (multidimensional-minimize f x tol): Nelder-Mead from x (n values), which
  * receives the minimizing point. The kernel takes the n coordinates. */
-void sicm_drive_multimin(const sicm_site *site, sicm_closure f, size_t n, double *x, double tol);
+void sicm_drive_multimin(const sicm_site *site, sicm_closure f, size_t n, double *x, double tol,
+                         int as_list);
 
 /* (find-root f a b tol): a root of f in [a, b] by Brent's method; the ends
  * must bracket a root. */
@@ -186,8 +187,7 @@ void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double
  * the monitor compiled for that state (so they print as exact, as in sicm
  * run). */
 void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure first,
-                       sicm_closure monitor,
-                       double *y, double dt, double t_final);
+                       sicm_closure monitor, double *y, double dt, double t_final);
 
 /* ---- parallel-map and parallel-for-each (parallel.c) ----
  *
