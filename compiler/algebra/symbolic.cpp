@@ -65,15 +65,16 @@ thread_local int g_decimal_constants = 0;
 
 thread_local KernelParameters *g_kernel_parameters = nullptr;
 
-// A flonum that a kernel takes as a parameter: finite, and not one of the
-// values whose folding changes the kernel's structure: 0, and the small
-// multiples of 1/8 (1., -1., 2., .5, 1.5: a unit mass or length, the 1/2
-// of a kinetic energy made inexact by an inexact mass), which cancel,
-// vanish from products and keep divisions out of mass matrices when folded.
+// A flonum that a kernel takes as a parameter: any finite flonum but 0.
+// Zero alone is folded, because it changes the kernel's structure (a term
+// with a zero coefficient vanishes: an effect switched off costs nothing)
+// and folding it rounds nothing. Any other value folded as a constant
+// (1.5 times 2/3 made 1, 2. merged with the 1/2 of a kinetic energy) would
+// round otherwise than the executable does when the same number is a
+// run-time value there (a (parameter) not --fix'ed, a scan's loop
+// variable), and sicm run and the executable must compute the same bits.
 bool parametric_flonum(Value v) {
-  if (!v.is(Tag::Flonum) || !std::isfinite(v.d)) return false;
-  double eighths = v.d * 8;
-  return !(eighths == std::floor(eighths) && std::fabs(eighths) <= 128);
+  return v.is(Tag::Flonum) && std::isfinite(v.d) && v.d != 0;
 }
 
 bool captured_run_time_value(Value v) {

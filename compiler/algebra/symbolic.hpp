@@ -77,10 +77,11 @@ Value decimal_rational(double d);
 // differ only in value are then one kernel: a parameter scan, a map that
 // makes a new system at every step, a Lagrangian redefined in the REPL with
 // new numbers compile once. Numbers that change a kernel's structure stay
-// constants: exact numbers, the flonums that are small multiples of 1/8
-// (0., 1., -1., 2., .5: a term with a zero coefficient vanishes, an effect
-// switched off costs nothing, a unit mass divides nothing) and exponents.
-// Equal flonums are one parameter.
+// constants: exact numbers, exponents and 0. (a term with a zero
+// coefficient vanishes: an effect switched off costs nothing). Every other
+// flonum is a parameter, even 1. or 2.: folded, it would round otherwise
+// than the executable's run-time value of the same number. Equal flonums
+// are one parameter.
 //
 // Parameter j is the uninterned symbol k<j>. sicm build says which values
 // are captured run-time values (is_captured: a symbol or an expression that

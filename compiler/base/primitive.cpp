@@ -42,11 +42,19 @@ const char *ordinal(int n) {
 namespace {
 
 RunTimeValueTest g_run_time_value_test = nullptr;
+RunTimeWriter g_run_time_writer = nullptr;
+
+// Can an argument error about obj, which holds run-time values, be written
+// now? Only when obj is a structure, vector or list (its kind, known now,
+// is what is wrong) and the error is certain to happen where it is raised.
+bool writable_when_run(Value obj) {
+  return g_run_time_writer && !g_run_time_value_test(obj) && raised_at_top_level();
+}
 
 // A primitive that only sicm run computes, given a value known only at run
 // time by sicm build.
 void refuse_run_time_argument(Value obj, int argpos, const char *who) {
-  if (!g_run_time_value_test || !holds_run_time_value(obj)) return;
+  if (!g_run_time_value_test || !holds_run_time_value(obj) || writable_when_run(obj)) return;
   bool number = g_run_time_value_test(obj);
   throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, current_call_loc(),
               std::string("cannot compile: ") + who + " of " +
@@ -66,6 +74,18 @@ void set_run_time_value_test(RunTimeValueTest test) {
 RunTimeValueTest run_time_value_test() {
   return g_run_time_value_test;
 }
+
+void set_run_time_writer(RunTimeWriter writer) {
+  g_run_time_writer = writer;
+}
+
+namespace {
+// obj as an argument error writes it (see RunTimeWriter).
+std::string written_argument(Value obj) {
+  if (g_run_time_value_test && holds_run_time_value(obj)) return g_run_time_writer(obj);
+  return written(obj);
+}
+} // namespace
 
 bool holds_run_time_value(Value v, int depth) {
   if (!g_run_time_value_test) return false;
@@ -89,21 +109,21 @@ bool holds_run_time_value(Value v, int depth) {
 
 void wrong_type(Value obj, int argpos, const char *who) {
   refuse_run_time_argument(obj, argpos, who);
-  runtime_error(current_call_loc(), "The object " + written(obj) + ", passed as the " +
+  runtime_error(current_call_loc(), "The object " + written_argument(obj) + ", passed as the " +
                                         ordinal(argpos) + " argument to " + who +
                                         ", is not the correct type.");
 }
 
 void bad_range(Value obj, int argpos, const char *who) {
   refuse_run_time_argument(obj, argpos, who);
-  runtime_error(current_call_loc(), "The object " + written(obj) + ", passed as the " +
+  runtime_error(current_call_loc(), "The object " + written_argument(obj) + ", passed as the " +
                                         ordinal(argpos) + " argument to " + who +
                                         ", is not in the correct range.");
 }
 
 void bad_range(Value obj, int argpos, const char *who, const std::string &rule) {
   refuse_run_time_argument(obj, argpos, who);
-  runtime_error(current_call_loc(), "The object " + written(obj) + ", passed as the " +
+  runtime_error(current_call_loc(), "The object " + written_argument(obj) + ", passed as the " +
                                         ordinal(argpos) + " argument to " + who +
                                         ", is not in the correct range (" + rule + ").");
 }

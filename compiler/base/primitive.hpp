@@ -51,6 +51,15 @@ RunTimeValueTest run_time_value_test(); // null outside sicm build
 // (looked into to a bounded depth and size)? An error message about it
 // would show the build's names for them, not the numbers sicm run shows.
 bool holds_run_time_value(Value v, int depth = 4);
+// sicm build: how to write, in an error message, a structure, vector or
+// list that holds run-time numbers, when the error is certain (the object's
+// own kind is wrong, whatever its numbers) and raised at the program's top
+// level: the text names the numbers by markers that the build turns into
+// printing when the executable fails there (pe/build_mode.cpp), so the
+// executable prints what sicm run prints. Null: such an error is the
+// compiler's "cannot compile".
+using RunTimeWriter = std::string (*)(Value);
+void set_run_time_writer(RunTimeWriter writer);
 
 // MIT-style argument errors, raised at current_call_loc(). argpos is 1-based.
 //   "The object (), passed as the first argument to car, is not the correct type."

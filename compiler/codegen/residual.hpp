@@ -94,7 +94,10 @@ enum class RKind : uint8_t {
                // to args[i*w .. i*w+w) (w = args / count); its outputs are the next ones of
                // outs, member by member (sicm_parallel_map runs them on threads and ranks)
   Fail,        // the program fails here: `text` is the whole message for stderr (an error
-               // the build met at the program's top level, which sicm run raises there)
+               // the build met at the program's top level, which sicm run raises there);
+               // empty `text`: the message printed since FailCapture
+  FailCapture, // what prints from here on is the message of the Fail that follows (it
+               // holds numbers computed at run time)
 };
 
 struct RStmt {

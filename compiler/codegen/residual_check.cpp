@@ -212,7 +212,10 @@ private:
       uses(a);
     switch (s.kind) {
     case RKind::Text: break;
-    case RKind::Fail: require(!s.text.empty(), "fails without a message"); break;
+    case RKind::Fail:
+      require(!s.text.empty() || capturing_, "fails without a message");
+      break;
+    case RKind::FailCapture: capturing_ = true; break;
     case RKind::Let: let(s); break;
     case RKind::Print: use(s.var); break;
     case RKind::Frame:
@@ -372,6 +375,7 @@ private:
   std::vector<bool> defined_; // per variable: defined so far in the function walked
   std::unordered_map<Symbol *, int> ids_;
   std::vector<const RStmt *> loops_; // the loops around the statement walked
+  bool capturing_ = false;           // a FailCapture was met: a Fail may print its message
   int f_ = 0;
   std::string where_;
 };

@@ -188,6 +188,7 @@ const char *statement_kind_name(RKind k) {
   case RKind::ListConst: return "list-const";
   case RKind::ParallelMap: return "parallel-map";
   case RKind::Fail: return "fail";
+  case RKind::FailCapture: return "fail-capture";
   }
   return "?";
 }

@@ -502,7 +502,10 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     case RKind::Break: return loop_exit(s, prefix, s.results, "break;\n");
     case RKind::If:
     case RKind::Loop: // written by block()
-    case RKind::Fail: return "sicm_program_fail_diagnostic(" + c_string_literal(s.text) + ");\n";
+    case RKind::Fail:
+      if (s.text.empty()) return "sicm_program_fail_captured();\n";
+      return "sicm_program_fail_diagnostic(" + c_string_literal(s.text) + ");\n";
+    case RKind::FailCapture: return "sicm_program_fail_capture();\n";
     }
     return "";
   }

@@ -186,7 +186,7 @@ int build_program(const BuildOptions &o) {
     if (e.kind != ErrorKind::Runtime || e.cause != ErrorCause::Other || !e.at_top_level) throw;
     build.fail_here(e);
     std::fprintf(stderr, "%s: warning: the program fails here when it runs: %s\n",
-                 loc_text(e.loc).c_str(), e.what());
+                 loc_text(e.loc).c_str(), BuildSession::described(e.what()).c_str());
   }
   check_residual(program, "partial evaluation");
   if (int status = check_parameter_options()) return status;

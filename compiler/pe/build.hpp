@@ -33,6 +33,9 @@ public:
   // run prints it (e was raised at the top level: e.at_top_level): the
   // output before it is printed first, then the executable exits 70.
   void fail_here(const Error &e);
+  // An error message for the compiler's own words (its warning): the
+  // numbers known only at run time in it written <run-time number>.
+  static std::string described(const std::string &message);
 
 private:
   build::BuildState *state_; // in memory the collector scans (it holds Values)

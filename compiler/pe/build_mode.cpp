@@ -226,13 +226,18 @@ bool contains_dynamic(Value v) {
   return false;
 }
 
-std::string describe(Value v) {
-  std::string s = write_string(v);
+// s with each run-time variable's marker written <run-time number>.
+std::string without_markers(std::string s) {
   for (size_t m; (m = s.find(kMarkerPrefix)) != std::string::npos;) {
     size_t end = s.find(kMarkerSuffix, m + sizeof kMarkerPrefix - 1);
     if (end == std::string::npos) break;
     s.replace(m, end + sizeof kMarkerSuffix - 1 - m, "<run-time number>");
   }
+  return s;
+}
+
+std::string describe(Value v) {
+  std::string s = without_markers(write_string(v));
   if (s.size() > 60) s = s.substr(0, 60) + "...";
   return s;
 }
@@ -680,6 +685,12 @@ Value prepare_toplevel(Value v) {
   return prepare_for_print(v);
 }
 
+// An argument error's object that holds run-time numbers, written with
+// markers that fail_here turns into printing (see RunTimeWriter).
+std::string write_with_markers(Value v) {
+  return written(prepare_for_print(v));
+}
+
 } // namespace
 
 // What this file specializes (the table is pe/specialized.cpp).
@@ -777,6 +788,7 @@ void begin_build_mode(build::BuildState *state) {
   set_capture_hook(hook_capture);
   set_print_preparer(prepare_toplevel);
   set_top_level_probe(at_program_top_level);
+  set_run_time_writer(write_with_markers);
   g_dynamic_branch_hooks = &kHooks;
 }
 
@@ -794,6 +806,7 @@ void end_build_mode() {
   set_print_preparer(nullptr);
   set_run_time_value_test(nullptr);
   set_top_level_probe(nullptr);
+  set_run_time_writer(nullptr);
   g_build = nullptr;
 }
 
@@ -819,10 +832,22 @@ ResidualProgram &BuildSession::program() {
 void BuildSession::fail_here(const Error &e) {
   SICM_ASSERT(build::g_build == state_ && e.at_top_level);
   flush_output(); // what the program printed before, in its place
+  std::string message = format_error(e); // the bytes sicm run writes on stderr
   RStmt s{RKind::Fail};
   s.loc = e.loc;
-  s.text = format_error(e); // the bytes sicm run writes on stderr
+  if (message.find(build::kMarkerPrefix) == std::string::npos) {
+    s.text = std::move(message);
+  } else { // numbers known at run time in it: printed into the message there
+    RStmt capture{RKind::FailCapture};
+    capture.loc = e.loc;
+    build::emit(std::move(capture));
+    build::residual_output(message);
+  }
   build::emit(std::move(s));
+}
+
+std::string BuildSession::described(const std::string &message) {
+  return build::without_markers(message);
 }
 
 } // namespace sicm

@@ -159,6 +159,8 @@ bool is_dynamic_boolean(Value v);
 bool contains_dynamic(Value v);
 // v written for an error message, run-time values as <run-time number>.
 std::string describe(Value v);
+// s with the build's name of each run-time number written <run-time number>.
+std::string without_markers(std::string s);
 // A number, a boolean or a run-time value as an expression node (who: for the error).
 ExprId expr_of(Value v, const char *who);
 // The kind of number (or truth value) v would print as.

@@ -209,14 +209,36 @@ void sicm_program_fail_diagnostic(const char *diagnostic) {
   sicm_program_fail_message(diagnostic);
 }
 
+/* The message being printed by sicm_program_fail_capture's caller, or NULL. */
+static FILE *capture;
+static char *captured;
+static size_t captured_size;
+
+void sicm_program_fail_capture(void) {
+  fflush(stdout);
+  if (!capture) capture = open_memstream(&captured, &captured_size);
+}
+
+void sicm_program_fail_captured(void) {
+  char *message = NULL;
+  if (capture && fclose(capture) == 0) message = captured;
+  capture = NULL;
+  sicm_program_fail_message(message); /* NULL: "out of memory" */
+}
+
 /* ---- printing --------------------------------------------------------------------- */
 
 void sicm_program_write(const char *s, size_t len) {
   if (!quiet) fwrite(s, 1, len, stdout);
 }
 
-/* Every print: to the running member's log, or to stdout. */
+/* Every print: into a failure's message, to the running member's log, or to
+ * stdout. */
 static void print(const char *s, size_t len) {
+  if (capture) {
+    fwrite(s, 1, len, capture);
+    return;
+  }
   if (!sicm_parallel_log_text(s, len)) sicm_program_write(s, len);
 }
 

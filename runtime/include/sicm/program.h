@@ -79,6 +79,19 @@ void sicm_program_fail_diagnostic(const char *diagnostic)
 #endif
     ;
 
+/* A failure whose message holds numbers computed at run time (an object of
+ * the wrong kind that holds them: "The object (up 1. .5 -.25), passed as
+ * the first argument to car, ..."): after sicm_program_fail_capture, what
+ * the sicm_print_* functions print goes into the message, and
+ * sicm_program_fail_captured fails with it as sicm_program_fail_diagnostic
+ * does. */
+void sicm_program_fail_capture(void);
+void sicm_program_fail_captured(void)
+#if defined(__GNUC__)
+    __attribute__((noreturn))
+#endif
+    ;
+
 /* The operations of the program's own arithmetic (not of kernels) that
  * sicm run would not answer with a real number: they fail at `site` as the
  * interpreter does where it raises an error (division by zero: "Division by
