@@ -50,9 +50,11 @@
 #include "base/number.hpp"
 #include "base/primitive.hpp"
 #include "builtins/compiled_procedures.hpp"
+#include "builtins/integration_errors.hpp"
 #include "builtins/integration_sites.hpp"
 #include "builtins/numeric_arguments.hpp"
 #include "builtins/numerics_defaults.hpp"
+#include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
@@ -424,12 +426,7 @@ int call_sysder(double, const double *y, double *dydt, void *data) {
   try {
     Value state = cb->shape->build(y);
     Value d = apply_procedure(cb->sysder, &state, 1);
-    if (!cb->shape->read(d, dydt)) {
-      Value shown = cb->shape->build(y);
-      runtime_error(cb->loc, std::string(cb->who) + ": the system derivative returned " +
-                                 write_string(d) + " for the state " + write_string(shown) +
-                                 "; it must be a structure of real numbers of the state's shape");
-    }
+    if (!cb->shape->read(d, dydt)) derivative_shape_error(cb->loc, cb->who, d, cb->shape->build(y));
     if (cb->shape->time_first() && dydt[0] != 1.0) cb->time_rate_one = false;
     return 0;
   } catch (...) {
@@ -622,21 +619,19 @@ struct OdeProblem {
     }
     if (cb.kernel && cb.kernel->taylor) {
       if (T == sicm_ode_step_taylor_extended)
-        sicm_ode_set_taylor_extended(ode, cb.kernel->taylor_extended, kernel_params(cb.kernel));
+        sicm_ode_set_taylor_extended(ode, cb.kernel->taylor_extended, taylor_params(cb.kernel));
       else
-        sicm_ode_set_taylor(ode, cb.kernel->taylor, kernel_params(cb.kernel));
+        sicm_ode_set_taylor(ode, cb.kernel->taylor, taylor_params(cb.kernel));
       return;
     }
-    std::string why = !cb.kernel ? "this one is interpreted, not compiled (it cannot be traced, or "
-                                   "--max-compiled-kernels was reached)"
-                      : cb.kernel->taylor_why_not.empty()
-                          ? "this one was compiled without them"
-                          : "this one has " + cb.kernel->taylor_why_not;
-    numeric_error(cb.loc, cb.who,
-                  std::string(sicm_ode_step_type_name(T)) +
-                      " needs a compiled system derivative whose operations all have Taylor "
-                      "recurrences; " +
-                      why);
+    const char *method = sicm_ode_step_type_name(T);
+    if (!cb.kernel) // not one expression of the state, which the build says alike
+      taylor_refused(cb.loc, cb.who, method,
+                     jit_limit_reached() ? TaylorRefusal::KernelLimit
+                                         : TaylorRefusal::NotOneExpression);
+    taylor_refused(cb.loc, cb.who, method, TaylorRefusal::NoRecurrence,
+                   cb.kernel->taylor_why_not.empty() ? "no Taylor coefficients"
+                                                     : cb.kernel->taylor_why_not);
   }
 
   // For sicm bench: this integration, from the current state over [t0, t1].

@@ -489,6 +489,7 @@ void *loaded_handle(const std::string &so) {
 }
 
 thread_local SrcLoc g_request_site; // see JitRequest
+std::atomic<bool> g_limit_reached{false};
 
 // Is there room for one more shared object under --max-compiled-kernels?
 // When there is not, the first refusal says so on stderr, at the user's line.
@@ -500,6 +501,7 @@ bool may_load_another(std::string *why_not) {
     loaded = g_handles.size();
   }
   if (limit == kUnlimited || loaded < limit) return true;
+  g_limit_reached = true;
   *why_not = "the process has compiled " + std::to_string(loaded) +
              " distinct procedures (--max-compiled-kernels)";
   static std::atomic<bool> told{false};
@@ -543,6 +545,10 @@ std::vector<std::string> sanitizer_flags() {
 #else
   return {};
 #endif
+}
+
+bool jit_limit_reached() {
+  return g_limit_reached;
 }
 
 uint64_t jit_compiler_runs() {

@@ -62,6 +62,9 @@ std::vector<std::string> sanitizer_flags();
 // see that the cache works).
 uint64_t jit_compiler_runs();
 
+// Has --max-compiled-kernels refused a procedure in this process?
+bool jit_limit_reached();
+
 // The cache directory jit_load would use now (created if missing).
 std::string jit_cache_dir();
 

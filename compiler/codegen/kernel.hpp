@@ -79,7 +79,8 @@ struct Kernel {
   std::vector<double> params;
   // Under SICM_INTERPRET=1 (codegen/kernel_interpreter.hpp): what fn and
   // singular_factors run instead of loaded code (c_source is still the C
-  // they would compile, so_path empty, no Taylor functions); else null.
+  // they would compile, so_path empty; the Taylor functions, which the
+  // kernel interpreter does not run, are compiled even so); else null.
   std::shared_ptr<const InterpretedKernel> interpreted;
 };
 
@@ -88,6 +89,12 @@ struct Kernel {
 // functions run (not numbers: only k's functions may be given it).
 inline const double *kernel_params(const Kernel *k) {
   if (k->interpreted) return reinterpret_cast<const double *>(k->interpreted.get());
+  return k->params.empty() ? nullptr : k->params.data();
+}
+
+// The p[] to pass to k's Taylor functions: compiled C in both modes, they
+// take the numbers of k->params.
+inline const double *taylor_params(const Kernel *k) {
   return k->params.empty() ? nullptr : k->params.data();
 }
 

@@ -294,12 +294,9 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
   std::string taylor_name = c_name + "_taylor", taylor_why_not;
   std::string extended_name = c_name + "_taylor_extended";
   bool has_taylor = false;
-  if (options.taylor && kernels_interpreted())
-    taylor_why_not = "no Taylor coefficients under SICM_INTERPRET=1 (the kernel interpreter "
-                     "runs the derivative, not the Taylor recurrences)";
-  else if (options.taylor && list_length(sample_args) != 1)
+  if (options.taylor && list_length(sample_args) != 1)
     taylor_why_not = "it is not a system derivative (a procedure of one state)";
-  if (options.taylor && !kernels_interpreted() && list_length(sample_args) == 1) {
+  if (options.taylor && list_length(sample_args) == 1) {
     std::string taylor = emit_taylor_function(t, taylor_name, &taylor_why_not);
     std::string extended =
         emit_taylor_function(t, extended_name, &taylor_why_not, TaylorPrecision::Extended);
@@ -322,6 +319,18 @@ Kernel *compile_kernel(Value proc, Value sample_args, const char *name, std::str
       interpreted->singular_factors = load_kernel_program(factors.values, t.inputs, {});
     for (Value v : t.params)
       interpreted->params.push_back(to_double(v));
+    // The kernel interpreter runs the derivative, not Taylor recurrences:
+    // a taylor method's coefficients are compiled C even so, the C sicm
+    // build compiles, so the integration gives the same bits.
+    if (has_taylor) {
+      std::string why;
+      taylor_fn = jit_load(source, taylor_name, &so, &why);
+      extended_fn = taylor_fn ? jit_load(source, extended_name, &so, &why) : nullptr;
+      if (!taylor_fn || !extended_fn) {
+        taylor_fn = extended_fn = nullptr;
+        taylor_why_not = "no Taylor coefficients: " + why;
+      }
+    }
   } else {
     fn = jit_load(source, c_name, &so, why_not);
     if (!fn) return nullptr;

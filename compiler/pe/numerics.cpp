@@ -13,10 +13,12 @@
 
 #include "algebra/generic.hpp"
 #include "algebra/linear_solve.hpp"
+#include "algebra/structure.hpp"
 #include "algebra/symbolic.hpp"
 #include "base/limits.hpp"
 #include "base/number.hpp"
 #include "base/primitive.hpp"
+#include "builtins/integration_errors.hpp"
 #include "builtins/numeric_arguments.hpp"
 #include "builtins/numerics_defaults.hpp"
 #include "codegen/emit_taylor.hpp"
@@ -551,25 +553,68 @@ void mark_if_kernel(RFunction &f) {
 
 } // namespace
 
+namespace {
+
+// v with each number made a flonum, as an integrator holds a state.
+Value inexact_leaves(Value v) {
+  if (is_number(v)) return Value::flonum(to_double(v));
+  if (is_structure(v)) {
+    Structure *s = as_structure(v);
+    gcvec<Value> items(s->items, s->items + s->len);
+    for (Value &x : items)
+      x = inexact_leaves(x);
+    return make_structure_from(s->up, items.data(), items.size());
+  }
+  if (v.is(Tag::Vector)) {
+    Vector *w = v.vector();
+    Value r = make_vector(w->len, Value::unspecified());
+    for (size_t i = 0; i < w->len; ++i)
+      r.vector()->items[i] = inexact_leaves(w->items[i]);
+    return r;
+  }
+  return v;
+}
+
+// Thrown out of the trace when the derivative's value is not shaped like a
+// state known now (see trace_system_function).
+struct NotShapedLikeState {};
+
+} // namespace
+
 // A system derivative traced into a new function of the state's leaves
 // whose outputs are the derivative's leaves, in the form the interpreter's
 // compiled derivatives take (kernel_outputs: evolve in `sicm run` compiles
 // the same kernel, so both compute the same numbers). Returns its id.
+//
+// A value not shaped like the state is sicm run's error at the call
+// (derivative_shape_error), certain when the state is known now: the
+// derivative's value on the state as the integrator holds it (leaves made
+// flonums), computed once the trace is left, is not shaped like it either.
+// Else the message would need numbers known only at run time: cannot
+// compile.
 int trace_system_function(Value sysder, Value state, const char *who) {
   if (!is_state_shape(state)) wrong_type(state, 1, who);
-  KernelTraceScope parameters;
-  FunctionScope scope(procedure_name(sysder));
-  gcvec<Value> x{kernel_input_like(state)};
-  Value d = apply_kernel_traced(sysder, x); // as sicm run traces its kernels
-  gcvec<Value> leaves;
-  if (!derivative_leaves(d, state, leaves, is_scalar_leaf))
-    cannot_compile(here(), std::string("the system derivative passed to ") + who + " returns " +
+  SrcLoc call = here(); // the integrator's call: the trace moves into sysder
+  try {
+    KernelTraceScope parameters;
+    FunctionScope scope(procedure_name(sysder));
+    gcvec<Value> x{kernel_input_like(state)};
+    Value d = apply_kernel_traced(sysder, x); // as sicm run traces its kernels
+    gcvec<Value> leaves;
+    if (!derivative_leaves(d, state, leaves, is_scalar_leaf)) {
+      if (!contains_dynamic(state)) throw NotShapedLikeState{};
+      cannot_compile(call, std::string("the system derivative passed to ") + who + " returns " +
                                describe(d) + ", which is not shaped like the state " +
                                describe(state));
-  std::vector<ExprId> outputs = system_outputs(leaves, who);
-  current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
-  mark_if_kernel(current());
-  return scope.id();
+    }
+    std::vector<ExprId> outputs = system_outputs(leaves, who);
+    current().outputs.insert(current().outputs.end(), outputs.begin(), outputs.end());
+    mark_if_kernel(current());
+    return scope.id();
+  } catch (const NotShapedLikeState &) {
+    Value held = inexact_leaves(state);
+    derivative_shape_error(call, who, apply_procedure(sysder, &held, 1), held);
+  }
 }
 
 namespace {
@@ -594,11 +639,7 @@ void check_taylor(const RStmt &s, const char *who) {
   if (s.method != "sicm_ode_step_taylor" && s.method != "sicm_ode_step_taylor_extended") return;
   const char *method = s.method == "sicm_ode_step_taylor" ? "taylor" : "taylor-extended";
   const RFunction &f = g_build->program.functions[s.callee];
-  if (!f.body.empty())
-    cannot_compile(s.loc, std::string(who) + ": " + method +
-                              " needs a system derivative that is one expression of the state; "
-                              "this one tests or reads run-time values; choose another "
-                              "integrator");
+  if (!f.body.empty()) taylor_refused(s.loc, who, method, TaylorRefusal::NotOneExpression);
   Trace t;
   for (int v : f.inputs)
     t.inputs.push_back(g_build->program.vars[v].sym);
@@ -606,10 +647,7 @@ void check_taylor(const RStmt &s, const char *who) {
   std::string why_not;
   auto any_symbol = [](Symbol *) { return std::string("p[0]"); };
   if (emit_taylor_function(t, "check", &why_not, TaylorPrecision::Double, any_symbol).empty())
-    cannot_compile(s.loc, std::string(who) + ": " + method +
-                              " needs a compiled system derivative whose operations all have "
-                              "Taylor recurrences; this one has " +
-                              why_not);
+    taylor_refused(s.loc, who, method, TaylorRefusal::NoRecurrence, why_not);
 }
 
 // What the system derivative divides by, as a function of its own inputs
