@@ -43,7 +43,9 @@ protected:
 
   // The JSON of `sicm report` on a program whose state derivative is the
   // driven pendulum's with drive amplitude `amplitude` (Scheme text), or the
-  // undriven pendulum's when it is empty.
+  // undriven pendulum's when it is empty. Mass and length are an exact 1,
+  // which folds (a flonum 1. would be a kernel parameter, and the two forms
+  // of the Lagrangian would then differ in their multiplications by it).
   std::string report(const std::string &amplitude, const std::string &options = "") {
     fs::path program = dir_ / ("scene" + std::to_string(n_++) + ".sicm");
     std::ofstream(program)
@@ -51,9 +53,9 @@ protected:
                 ? "(define ((L m l g) local)\n"
                   "  (+ (* 1/2 m (square (* l (velocity local)))) (* m g l (cos (coordinate "
                   "local)))))\n"
-                  "(define (sysder) (Lagrangian->state-derivative (L 1. 1. 9.8)))\n"
+                  "(define (sysder) (Lagrangian->state-derivative (L 1 1 9.8)))\n"
                 : "(define (sysder) (Lagrangian->state-derivative\n"
-                  "  (L-periodically-driven-pendulum 1. 1. 9.8 " +
+                  "  (L-periodically-driven-pendulum 1 1 9.8 " +
                       amplitude + " (* 2 (sqrt 9.8)))))\n")
         << "((state-advancer sysder) (up 0. 1. 0.) 1.)\n";
     fs::path json = program;
