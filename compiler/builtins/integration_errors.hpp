@@ -26,7 +26,7 @@ enum class TaylorRefusal {
   KernelLimit,      // sicm run: --max-compiled-kernels was reached before it
 };
 
-[[noreturn]] void taylor_refused(SrcLoc loc, const char *who, const char *method,
-                                 TaylorRefusal why, const std::string &operation = {});
+[[noreturn]] void taylor_refused(SrcLoc loc, const char *who, const char *method, TaylorRefusal why,
+                                 const std::string &operation = {});
 
 } // namespace sicm

@@ -132,12 +132,13 @@ const std::vector<NumericSignature> &numeric_signatures() {
       {"find-root", 3, 4, {R::Procedure, R::Finite, R::IntervalEnd, R::NonNegative}},
       // (bisect f x0 x1 eps [n-break])
       {"bisect", 4, 5, {R::Procedure, R::Finite, R::Finite, R::NonNegative, R::Index}},
-      // ((state-advancer sysder . params) state dt [tolerance [integrator]])
-      {"state-advancer", 2, 4, {R::Any, R::Finite, R::Tolerance, R::Integrator}},
+      // ((state-advancer sysder . params) state dt [tolerance [integrator [max-steps]]])
+      {"state-advancer", 2, 5, {R::Any, R::Finite, R::Tolerance, R::Integrator, R::Count}},
       // ((evolve sysder . params) state monitor dt t-final [tolerance
-      // [integrator]]); a step of 0 is the monitor schedule's to refuse
+      // [integrator [max-steps]]]); a step of 0 is the monitor schedule's to refuse
       // (sicm_monitor_schedule_start), after the first call of the monitor.
-      {"evolve", 4, 6, {R::Any, R::Procedure, R::Finite, R::Finite, R::Tolerance, R::Integrator}},
+      {"evolve", 4, 7,
+       {R::Any, R::Procedure, R::Finite, R::Finite, R::Tolerance, R::Integrator, R::Count}},
   };
   return table;
 }

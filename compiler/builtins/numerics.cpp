@@ -585,10 +585,14 @@ struct OdeProblem {
     t0 = shape.time_first() && std::isfinite(y[0]) ? y[0] : 0.0;
   }
 
-  OdePtr make_integrator(const sicm_ode_step_type *T, double eps) {
+  // max_steps: the most steps to one output time (the user's max-steps
+  // argument), 0 for the runtime's default.
+  OdePtr make_integrator(const sicm_ode_step_type *T, double eps, unsigned long max_steps) {
     OdePtr ode(sicm_ode_alloc(T, shape.dim(), call_sysder, &cb, eps, eps),
                OdeDeleter{cb.loc, cb.who, eps, &seconds});
     if (!ode) numeric_error(cb.loc, cb.who, reason_of(g_runtime_message));
+    if (max_steps && sicm_ode_set_max_steps(ode.get(), max_steps))
+      numeric_error(cb.loc, cb.who, reason_of(g_runtime_message));
     // What the compiled derivative divides by, to name a singularity where
     // the integration fails.
     if (cb.kernel && cb.kernel->singular_factors) {
@@ -683,8 +687,14 @@ Value make_named_procedure(NativeFn fn, Value sysder, Lambda *lambda) {
   return p;
 }
 
-// ((state-advancer sysder . params) state dt [eps [integrator]]): the state
-// dt later.
+// The optional max-steps argument at a[i] (check_numeric_arguments made it
+// a count): the most steps to one output time; 0 for the runtime's default.
+unsigned long optional_max_steps(Value *a, int n, int i) {
+  return is_missing(a, n, i) ? 0 : static_cast<unsigned long>(a[i].i);
+}
+
+// ((state-advancer sysder . params) state dt [eps [integrator [max-steps]]]):
+// the state dt later.
 Value advance_state(NativeProc *self, Value *a, int n) {
   static const char who[] = "state-advancer";
   check_numeric_arguments(who, a, n, self);
@@ -692,6 +702,7 @@ Value advance_state(NativeProc *self, Value *a, int n) {
   double dt = real_at(a, 1);
   double eps = optional_real(a, n, 2, kAdvancerTolerance);
   const sicm_ode_step_type *T = arg_integrator(a, n, 3, who);
+  const unsigned long max_steps = optional_max_steps(a, n, 4);
   OdeProblem p(loc, who, self->a, a[0], 1,
                T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended ||
                    recording_integration_sites());
@@ -699,7 +710,7 @@ Value advance_state(NativeProc *self, Value *a, int n) {
   p.record_site(who, t1, eps, T);
   {
     RuntimeErrorScope scope;
-    OdePtr ode = p.make_integrator(T, eps);
+    OdePtr ode = p.make_integrator(T, eps, max_steps);
     p.evolve_to(ode.get(), t, t1);
   }
   return p.state_at(t1);
@@ -743,7 +754,8 @@ private:
   bool enabled_ = false, drawn_ = false;
 };
 
-// ((evolve sysder . params) state monitor dt final-time [eps [integrator]]):
+// ((evolve sysder . params) state monitor dt final-time [eps [integrator
+// [max-steps]]]):
 // calls (monitor state) at the initial state and every dt until the final
 // time (the last interval is shortened to end there); returns the final state.
 Value run_evolve(NativeProc *self, Value *a, int n) {
@@ -755,6 +767,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   double t_final = real_at(a, 3);
   double eps = optional_real(a, n, 4, kAdvancerTolerance);
   const sicm_ode_step_type *T = arg_integrator(a, n, 5, who);
+  const unsigned long max_steps = optional_max_steps(a, n, 6);
   OdeProblem p(loc, who, self->a, a[0], 1,
                T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended ||
                    recording_integration_sites());
@@ -768,7 +781,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   if (const char *why_not = sicm_monitor_schedule_start(&schedule, p.t0, dt, t_final))
     runtime_error(loc, std::string(who) + ": " + why_not);
   RuntimeErrorScope scope;
-  OdePtr ode = p.make_integrator(T, eps);
+  OdePtr ode = p.make_integrator(T, eps, max_steps);
   sicm_ode_set_horizon(ode.get(), t_final);
   double t = p.t0, tk;
   ProgressBar progress(p.t0, t_final);

@@ -123,6 +123,7 @@ struct RStmt {
   bool backward = false;    // Let of ListFold
   bool as_list = false;     // Multimin: the start point is a list (not a vector), for messages
   double number = 0;        // a tolerance
+  long max_steps = 0;       // Advance, Evolve: steps per output time, 0 for the runtime's default
   bool time_first = false, rate_one = false; // Advance, Evolve
   std::string method;                        // Advance, Evolve: the runtime's step type variable
   std::string text, title;

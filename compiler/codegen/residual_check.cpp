@@ -212,9 +212,7 @@ private:
       uses(a);
     switch (s.kind) {
     case RKind::Text: break;
-    case RKind::Fail:
-      require(!s.text.empty() || capturing_, "fails without a message");
-      break;
+    case RKind::Fail: require(!s.text.empty() || capturing_, "fails without a message"); break;
     case RKind::FailCapture: capturing_ = true; break;
     case RKind::Let: let(s); break;
     case RKind::Print: use(s.var); break;

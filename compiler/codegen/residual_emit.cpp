@@ -422,7 +422,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
            ", " + (s.time_first ? "1" : "0") + ", " + (s.rate_one ? "1" : "0") + ", " +
            c_double_literal(s.number) + ", " + closure(s.jacobian) + ", " + closure(s.probe) +
            ", " + std::to_string(s.probe_texts.size()) + ", " + probe_texts(s.probe_texts) + ", " +
-           taylor + ", " + extended + "}";
+           taylor + ", " + extended + ", " + std::to_string(s.max_steps) + "}";
   }
 
   // The Taylor coefficient function of system derivative f (fN_taylor or

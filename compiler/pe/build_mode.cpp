@@ -831,7 +831,7 @@ ResidualProgram &BuildSession::program() {
 
 void BuildSession::fail_here(const Error &e) {
   SICM_ASSERT(build::g_build == state_ && e.at_top_level);
-  flush_output(); // what the program printed before, in its place
+  flush_output();                        // what the program printed before, in its place
   std::string message = format_error(e); // the bytes sicm run writes on stderr
   RStmt s{RKind::Fail};
   s.loc = e.loc;

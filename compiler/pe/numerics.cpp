@@ -296,6 +296,12 @@ double static_number(Value *a, int n, int i, double fallback, const char *who) {
   return to_double(a[i]);
 }
 
+// An optional count at a[i] that check_numeric_arguments checked (an
+// exact integer, known now), or 0 when it is missing.
+long static_count(Value *a, int n, int i) {
+  return i >= n || a[i].is(Tag::Default) ? 0 : a[i].i;
+}
+
 ExprId limit_expr(Value v, const char *who) {
   if (is_symbol(v) && var_of(v) < 0) {
     const std::string &s = symbol_name(v);
@@ -749,6 +755,7 @@ Value advance(NativeProc *self, Value *a, int n) {
   s.loc = here();
   s.number = static_number(a, n, 2, kAdvancerTolerance, who);
   s.method = method_of(a, n, 3, who);
+  s.max_steps = static_count(a, n, 4);
   state_args(a[0], s, who);
   s.args.push_back(expr_of(a[1], who));
   trace_system(self->a, a[0], s, who);
@@ -773,6 +780,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   s.loc = here();
   s.number = static_number(a, n, 4, kAdvancerTolerance, who);
   s.method = method_of(a, n, 5, who);
+  s.max_steps = static_count(a, n, 6);
   state_args(a[0], s, who);
   s.args.push_back(expr_of(a[2], who));
   s.args.push_back(expr_of(a[3], who));

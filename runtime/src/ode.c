@@ -258,10 +258,12 @@ int sicm_ode_start_derivative(sicm_ode *o, double t, const double *y, double *f0
 }
 
 int sicm_ode_fail_max_steps(sicm_ode *o, double t, const double *y) {
-  char detail[160];
+  char detail[400];
   snprintf(detail, sizeof detail,
-           "%lu steps in one call did not reach the end; the problem may be stiff "
-           "(try msbdf or cvode-bdf) or the limit too low (sicm_ode_set_max_steps)",
+           "%lu steps did not reach the next output time (the limit counts the steps between "
+           "two calls of the monitor, or of one state advance); give a smaller monitor step, "
+           "a larger limit (evolve's or state-advancer's max-steps argument, after the "
+           "integrator), or, if the system is stiff, 'cvode-bdf",
            o->max_steps);
   return sicm_ode_fail(o, SICM_EMAXITER, t, y, "too many steps", detail);
 }

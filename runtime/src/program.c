@@ -533,6 +533,7 @@ static void open_integrator(const sicm_site *site, const char *who, const sicm_d
   if (ode->probe.fn && sicm_ode_set_singularity_probe(it->o, ode->probe.fn, ode->probe.p,
                                                       ode->probe_count, ode->probe_texts))
     fail_with_status(site, who);
+  if (ode->max_steps && sicm_ode_set_max_steps(it->o, ode->max_steps)) fail_with_status(site, who);
   if (ode->taylor) sicm_ode_set_taylor(it->o, ode->taylor, ode->sysder.p);
   if (ode->taylor_extended)
     sicm_ode_set_taylor_extended(it->o, ode->taylor_extended, ode->sysder.p);

@@ -186,6 +186,10 @@ typedef struct {
    * sysder's code and given sysder's p; NULL otherwise. */
   sicm_ode_taylor_coefficients taylor;
   sicm_ode_taylor_extended_coefficients taylor_extended;
+  /* The most steps the integrator may take to reach one output time (the
+   * next monitor call, or the advancer's end): evolve's and state-advancer's
+   * max-steps argument; 0 for the runtime's default. */
+  unsigned long max_steps;
 } sicm_drive_ode;
 
 /* ((state-advancer ...) state dt tol): y (dim leaves) becomes the state dt
