@@ -10,6 +10,7 @@
 
 #include "base/error.hpp"
 #include "base/value.hpp"
+#include "sicm/ode.h"
 
 namespace sicm {
 
@@ -25,6 +26,14 @@ enum class TaylorRefusal {
   NoRecurrence,     // an operation has no Taylor recurrence (`operation` says which)
   KernelLimit,      // sicm run: --max-compiled-kernels was reached before it
 };
+
+// The tolerance eps asks of integrator T what its arithmetic cannot give: a
+// relative error below about 1e-16 in double precision, 1e-20 in long
+// double (taylor-extended). An error naming the limit and the method that
+// can do better, rather than millions of steps and a worse answer. The
+// symplectic methods, whose tolerance argument is their step, have none.
+void check_reachable_tolerance(SrcLoc loc, const char *who, const sicm_ode_step_type *T,
+                               double eps);
 
 [[noreturn]] void taylor_refused(SrcLoc loc, const char *who, const char *method, TaylorRefusal why,
                                  const std::string &operation = {});

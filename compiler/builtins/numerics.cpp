@@ -702,6 +702,7 @@ Value advance_state(NativeProc *self, Value *a, int n) {
   double dt = real_at(a, 1);
   double eps = optional_real(a, n, 2, kAdvancerTolerance);
   const sicm_ode_step_type *T = arg_integrator(a, n, 3, who);
+  check_reachable_tolerance(loc, who, T, eps);
   const unsigned long max_steps = optional_max_steps(a, n, 4);
   OdeProblem p(loc, who, self->a, a[0], 1,
                T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended ||
@@ -767,6 +768,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   double t_final = real_at(a, 3);
   double eps = optional_real(a, n, 4, kAdvancerTolerance);
   const sicm_ode_step_type *T = arg_integrator(a, n, 5, who);
+  check_reachable_tolerance(loc, who, T, eps);
   const unsigned long max_steps = optional_max_steps(a, n, 6);
   OdeProblem p(loc, who, self->a, a[0], 1,
                T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended ||
@@ -1069,6 +1071,12 @@ const char *integrator_list() {
 const char *integrator_c_name(const std::string &name) {
   const IntegratorName *i = find_integrator(name);
   return i ? i->c_name : nullptr;
+}
+
+const sicm_ode_step_type *integrator_of_c_name(const std::string &c_name) {
+  for (const IntegratorName &i : kIntegrators)
+    if (c_name == i.c_name) return *i.type;
+  return nullptr;
 }
 
 const sicm_ode_step_type *integrator_named(const std::string &name) {

@@ -25,6 +25,9 @@ const char *integrator_c_name(const std::string &name);
 
 // The runtime's step type for an integrator's name, or null.
 const sicm_ode_step_type *integrator_named(const std::string &name);
+// The runtime's step type whose variable is c_name (integrator_c_name's
+// answer), or null.
+const sicm_ode_step_type *integrator_of_c_name(const std::string &c_name);
 
 // The integrators' names, for messages ("bulirsch-stoer, rk8pd, ...").
 const char *integrator_list();

@@ -755,6 +755,7 @@ Value advance(NativeProc *self, Value *a, int n) {
   s.loc = here();
   s.number = static_number(a, n, 2, kAdvancerTolerance, who);
   s.method = method_of(a, n, 3, who);
+  check_reachable_tolerance(s.loc, who, integrator_of_c_name(s.method), s.number);
   s.max_steps = static_count(a, n, 4);
   state_args(a[0], s, who);
   s.args.push_back(expr_of(a[1], who));
@@ -780,6 +781,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   s.loc = here();
   s.number = static_number(a, n, 4, kAdvancerTolerance, who);
   s.method = method_of(a, n, 5, who);
+  check_reachable_tolerance(s.loc, who, integrator_of_c_name(s.method), s.number);
   s.max_steps = static_count(a, n, 6);
   state_args(a[0], s, who);
   s.args.push_back(expr_of(a[2], who));
