@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "eval/procedure.hpp"
 #include "print/printer.hpp"
 
 namespace sicm {
@@ -52,6 +53,22 @@ void check_reachable_tolerance(SrcLoc loc, const char *who, const sicm_ode_step_
     what += "ask for 1e-16 or more, or use 'taylor-extended, which computes in long double "
             "(down to about 1e-20)";
   runtime_error(loc, what);
+}
+
+void check_monitor_arity(SrcLoc call, const char *who, Value monitor) {
+  if (!monitor.is(Tag::Closure)) return;
+  const Lambda *lambda = monitor.as<Closure>()->lambda;
+  const uint32_t required = lambda->nrequired, most = required + lambda->noptional;
+  if (required <= 1 && (lambda->rest || most >= 1)) return;
+  std::string takes = lambda->rest ? "at least " + std::to_string(required)
+                      : required == most
+                          ? "exactly " + std::to_string(required)
+                          : "between " + std::to_string(required) + " and " + std::to_string(most);
+  const bool one = !lambda->rest && most == 1 && required == 1;
+  SrcLoc at = lambda->loc.known() && !is_library_loc(lambda->loc) ? lambda->loc : call;
+  runtime_error(at, std::string(who) + ": the monitor " + write_string(monitor) + " takes " +
+                        takes + (one ? " argument" : " arguments") + "; " + who +
+                        " calls it with one argument, the state");
 }
 
 void taylor_refused(SrcLoc loc, const char *who, const char *method, TaylorRefusal why,

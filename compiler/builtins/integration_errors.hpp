@@ -35,6 +35,12 @@ enum class TaylorRefusal {
 void check_reachable_tolerance(SrcLoc loc, const char *who, const sicm_ode_step_type *T,
                                double eps);
 
+// evolve calls its monitor with one argument, the state: a compound
+// procedure that cannot take one is an error that says it is the monitor,
+// located at the monitor's own definition (the call's `call` when that is
+// not the user's).
+void check_monitor_arity(SrcLoc call, const char *who, Value monitor);
+
 [[noreturn]] void taylor_refused(SrcLoc loc, const char *who, const char *method, TaylorRefusal why,
                                  const std::string &operation = {});
 

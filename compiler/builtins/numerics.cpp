@@ -763,6 +763,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   static const char who[] = "evolve";
   check_numeric_arguments(who, a, n, self);
   SrcLoc loc = current_call_loc();
+  check_monitor_arity(loc, who, a[1]);
   Value monitor = a[1];
   double dt = real_at(a, 2);
   double t_final = real_at(a, 3);

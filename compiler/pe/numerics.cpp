@@ -776,6 +776,7 @@ Value P_state_advancer(Value *a, int n) {
 Value run_evolve(NativeProc *self, Value *a, int n) {
   static const char who[] = "evolve";
   check_numeric_arguments(who, a, n, self);
+  check_monitor_arity(here(), who, a[1]);
   Checkpoint before; // for a monitor whose trace fails (below)
   RStmt s{RKind::Evolve};
   s.loc = here();
