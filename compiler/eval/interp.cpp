@@ -8,6 +8,7 @@
 
 #include "eval/analyze.hpp"
 #include "eval/core.hpp"
+#include "eval/name_suggestion.hpp"
 #include "eval/procedure.hpp"
 #include "syntax/reader.hpp"
 
@@ -23,33 +24,6 @@ std::vector<GlobalUse> *g_uses = nullptr; // collecting during check_program
 
 void record_use(Symbol *name, SrcLoc loc) {
   if (g_uses) g_uses->push_back(GlobalUse{name, loc});
-}
-
-size_t edit_distance(const std::string &a, const std::string &b) {
-  std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j)
-    prev[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    cur[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j)
-      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
-    std::swap(prev, cur);
-  }
-  return prev[b.size()];
-}
-
-// The closest known name to `name`, or "" if nothing is close enough.
-std::string suggestion(const std::string &name, const std::vector<std::string> &known) {
-  std::string best;
-  size_t best_d = std::max<size_t>(1, name.size() / 3) + 1;
-  for (const std::string &k : known) {
-    size_t d = edit_distance(name, k);
-    if (d < best_d) {
-      best_d = d;
-      best = k;
-    }
-  }
-  return best;
 }
 
 } // namespace
@@ -91,7 +65,7 @@ gcvec<Node *> check_program(const gcvec<ReadForm> &forms) {
     std::vector<std::string> known = global_names();
     for (Symbol *d : defined)
       known.push_back(d->name);
-    std::string near = suggestion(u.name->name, known);
+    std::string near = suggested_name(u.name->name, known);
     throw Error(ErrorKind::Syntax, u.loc, "Unbound variable: " + u.name->name,
                 near.empty() ? "" : "did you mean '" + near + "'?");
   }
