@@ -34,12 +34,12 @@ TEST(Stats, OneLinePerSiteMethodAndTolerance) {
   EXPECT_EQ(
       printed(),
       "integration statistics (--stats), one line per site, method and tolerance:\n"
-      "x.sicm:3:1: evolve, rk8pd, tolerance .0000000001: 2 calls, 140 steps (6 rejected), 1800 rhs "
+      "x.sicm:3:1: evolve, rk8pd, tolerance 1e-10: 2 calls, 140 steps (6 rejected), 1800 rhs "
       "evaluations, .75 s\n"
-      "x.sicm:3:1: evolve, bulirsch-stoer, tolerance .0000000001: 1 call, 40 steps (1 rejected), "
+      "x.sicm:3:1: evolve, bulirsch-stoer, tolerance 1e-10: 1 call, 40 steps (1 rejected), "
       "500 "
       "rhs evaluations, .125 s\n"
-      "x.sicm:9:5: state-advancer, rk8pd, tolerance .0000000001: 1 call, 40 steps (1 rejected), "
+      "x.sicm:9:5: state-advancer, rk8pd, tolerance 1e-10: 1 call, 40 steps (1 rejected), "
       "500 "
       "rhs evaluations, .001 s\n");
 }
