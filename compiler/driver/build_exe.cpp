@@ -87,6 +87,26 @@ int run(const std::vector<std::string> &argv) {
 
 } // namespace
 
+int check_output_writable(const BuildOptions &o) {
+  const std::string &path = o.output;
+  struct stat st;
+  int error = 0;
+  if (stat(path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode))
+      error = EISDIR;
+    else if (access(path.c_str(), W_OK) != 0)
+      error = errno;
+  } else if (errno != ENOENT) {
+    error = errno;
+  } else if (access(dir_of(path).c_str(), W_OK) != 0) {
+    error = errno; // the directory is missing or closed to us
+  }
+  if (error == 0) return 0;
+  std::fprintf(stderr, "sicm: error: cannot write the executable %s: %s\n", path.c_str(),
+               std::strerror(error));
+  return kExitCantCreat;
+}
+
 int compile_executable(const std::string &c, const BuildOptions &o) {
   std::string include_dir, library;
   if (!find_runtime(&include_dir, &library)) {

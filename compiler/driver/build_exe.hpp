@@ -16,4 +16,9 @@ namespace sicm {
 // missing runtime or a failing C compiler is reported here.
 int compile_executable(const std::string &c, const BuildOptions &options);
 
+// Can the executable be written at options.output? 0 if it seems so; else
+// one line on stderr naming the path and the system's reason, and the exit
+// status. Checked before any work, so a mistyped -o costs no compilation.
+int check_output_writable(const BuildOptions &options);
+
 } // namespace sicm

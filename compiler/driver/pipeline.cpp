@@ -167,6 +167,8 @@ int emit_kernels(const std::string &path) {
 int build_program(const BuildOptions &o) {
   uint32_t file;
   if (!read_source(o.input, &file)) return kExitNoInput;
+  if (o.dump.empty() && !o.emit_only && !o.report_only)
+    if (int status = check_output_writable(o)) return status;
   if (o.dump == "analyzed") {
     for (const ReadForm &f : read_all(file))
       std::printf("%s\n", dump_node(analyze_form(f.datum, f.loc, nullptr)).c_str());

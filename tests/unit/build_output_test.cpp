@@ -1,0 +1,52 @@
+// sicm build -o PATH where PATH cannot be written: one line naming the path
+// and the system's reason, status 73, before any work (no partial
+// evaluation, no C compiler and its linker's messages).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string sicm_path() {
+  const char *e = std::getenv("SICM_BINARY");
+  return e && *e ? e : "build/sicm";
+}
+
+// stdout and stderr of `sicm build PROGRAM -o output`, then "status=N".
+std::string build_to(const std::string &output) {
+  fs::path program = fs::temp_directory_path() / "sicm-build-output-test.sicm";
+  std::ofstream(program) << "(display 1)\n";
+  std::string command =
+      sicm_path() + " build " + program.string() + " -o '" + output + "' 2>&1; echo status=$?";
+  std::string text;
+  if (FILE *p = popen(command.c_str(), "r")) {
+    char buf[512];
+    while (std::fgets(buf, sizeof buf, p))
+      text += buf;
+    pclose(p);
+  }
+  fs::remove(program);
+  return text;
+}
+
+} // namespace
+
+TEST(BuildOutput, AMissingDirectoryIsOneLine) {
+  if (!fs::exists(sicm_path())) GTEST_SKIP() << "no sicm binary at " << sicm_path();
+  EXPECT_EQ(build_to("/nonexistent-sicm-test-dir/scene"),
+            "sicm: error: cannot write the executable /nonexistent-sicm-test-dir/scene: No such "
+            "file or directory\nstatus=73\n");
+}
+
+TEST(BuildOutput, ADirectoryIsOneLine) {
+  if (!fs::exists(sicm_path())) GTEST_SKIP() << "no sicm binary at " << sicm_path();
+  std::string dir = fs::temp_directory_path().string();
+  EXPECT_EQ(build_to(dir),
+            "sicm: error: cannot write the executable " + dir + ": Is a directory\nstatus=73\n");
+}
