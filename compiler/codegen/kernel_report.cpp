@@ -78,8 +78,15 @@ std::map<std::string, size_t> count_c_ops(std::string_view body) {
       while (k < n && code[k] == ' ')
         ++k;
       if (k >= n || code[k] != '(' || kNotCalls.count(word)) continue;
+      // The checked forms of the program's own arithmetic (sicm/program.h)
+      // are the operation they check.
+      if (word == "sicm_checked_sqrt") word = "sqrt";
+      if (word == "sicm_checked_log") word = "log";
+      if (word == "sicm_checked_pow") word = "pow";
       if (word == "sincos") {
         ++ops["sin"], ++ops["cos"];
+      } else if (word == "sicm_checked_quotient") {
+        ++ops["div"];
       } else if (word == "sqrt" || word == "sin" || word == "cos" || word == "exp" ||
                  word == "log" || word == "pow" || word == "atan2") {
         ++ops[word];

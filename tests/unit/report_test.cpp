@@ -8,6 +8,8 @@
 // for run time, costs more. The JSON has the documented shape.
 #include <gtest/gtest.h>
 
+#include "codegen/kernel_report.hpp"
+
 #include <sys/stat.h>
 
 #include <cstdio>
@@ -139,3 +141,18 @@ TEST_F(Report, FixAndParamPrintTheSameNumbers) {
 }
 
 } // namespace
+
+// The checked forms of the program's own arithmetic count as the operation
+// they check: a square root of a run-time value is a sqrt, not a call.
+TEST(ReportOps, CheckedOperationsCountAsTheOperation) {
+  auto ops = sicm::count_c_ops(
+      "out[0] = sicm_checked_sqrt(&site0, r0 * r0 + 2.0) + sicm_checked_log(&site1, r0) + "
+      "sicm_checked_pow(&site2, r0, r1) + sicm_checked_quotient(&site3, \"/\", r0, r1);");
+  EXPECT_EQ(ops["sqrt"], 1u);
+  EXPECT_EQ(ops["log"], 1u);
+  EXPECT_EQ(ops["pow"], 1u);
+  EXPECT_EQ(ops["div"], 1u);
+  EXPECT_EQ(ops["call"], 0u);
+  EXPECT_EQ(ops["add"], 4u);
+  EXPECT_EQ(ops["mul"], 1u);
+}
