@@ -293,15 +293,7 @@ void *evaluator_thread(void *arg) {
     job->status = dispatch(job->args);
   } catch (const sicm::Error &e) {
     sicm::flush_output();
-    sicm::Error shown = e;
-    sicm::SrcLoc user = sicm::current_toplevel_loc();
-    if (sicm::is_library_loc(e.loc) && user.known()) {
-      // The user's form that led there comes first, the library's place in a note.
-      shown.loc = user;
-      shown.note = "raised inside the library, at " + sicm::loc_text(e.loc) +
-                   (e.note.empty() ? "" : "\nnote: " + e.note);
-    }
-    sicm::report_error(stderr, shown);
+    sicm::report_error(stderr, sicm::as_users_error(e));
     job->status = e.exit_code();
   } catch (const std::bad_alloc &) {
     sicm::flush_output();

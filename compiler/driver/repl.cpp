@@ -93,7 +93,7 @@ void print_result(Value datum, Value v) {
 void report(const Error &e) {
   fresh_line();
   flush_output();
-  report_error(stderr, e);
+  report_error(stderr, as_users_error(e));
 }
 
 void report_internal(const char *what) {

@@ -28,7 +28,12 @@ void record_use(Symbol *name, SrcLoc loc) {
 
 } // namespace
 
+namespace {
+SrcLoc g_toplevel_loc; // the top-level form being run (a program's, or a REPL entry's)
+} // namespace
+
 Value eval_toplevel(Value datum, SrcLoc loc) {
+  g_toplevel_loc = loc;
   Node *n = analyze_form(datum, loc, nullptr);
   return eval(n, nullptr);
 }
@@ -36,6 +41,17 @@ Value eval_toplevel(Value datum, SrcLoc loc) {
 bool is_printable_toplevel(Value datum, Value result) {
   if (is_definition(datum)) return false;
   return !result.is(Tag::Unspecified) && !result.is(Tag::Default);
+}
+
+Error as_users_error(const Error &e) {
+  Error shown = e;
+  SrcLoc user = current_toplevel_loc();
+  if (is_library_loc(e.loc) && user.known()) {
+    shown.loc = user;
+    shown.note = "raised inside the library, at " + loc_text(e.loc) +
+                 (e.note.empty() ? "" : "\nnote: " + e.note);
+  }
+  return shown;
 }
 
 std::vector<std::string> global_names() {
@@ -71,10 +87,6 @@ gcvec<Node *> check_program(const gcvec<ReadForm> &forms) {
   }
   return nodes;
 }
-
-namespace {
-SrcLoc g_toplevel_loc;
-} // namespace
 
 SrcLoc current_toplevel_loc() {
   return g_toplevel_loc;

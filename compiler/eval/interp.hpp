@@ -29,4 +29,9 @@ gcvec<struct Node *> check_program(const gcvec<struct ReadForm> &forms);
 // The names bound in the global environment (for REPL completion).
 std::vector<std::string> global_names();
 
+// e as the user should see it: an error raised inside the library is
+// located at the user's form that led there (current_toplevel_loc: a line
+// of the program, or the REPL's entry), the library's place in a note.
+Error as_users_error(const Error &e);
+
 } // namespace sicm
