@@ -42,6 +42,7 @@ struct Run {
   sicm_ode_stats work{};
   std::vector<double> final;
   double error = 0;
+  std::string why_not; // when !ok: the integrator's reason (too many steps, ...)
 };
 
 int call_kernel(double, const double *y, double *dydt, void *data) {
@@ -60,7 +61,10 @@ Run integrate_once(const IntegrationSite &site, const sicm_ode_step_type *T, dou
   sicm_ode *o = sicm_ode_alloc(T, site.y.size(), call_kernel, const_cast<IntegrationSite *>(&site),
                                tolerance, tolerance);
   r.final = site.y;
-  if (!o) return r;
+  if (!o) {
+    r.why_not = "the integrator could not be made";
+    return r;
+  }
   const double *p = site.params.empty() ? nullptr : site.params.data();
   if (T == sicm_ode_step_taylor && site.taylor) sicm_ode_set_taylor(o, site.taylor, p);
   if (T == sicm_ode_step_taylor_extended && site.taylor_extended)
@@ -69,6 +73,7 @@ Run integrate_once(const IntegrationSite &site, const sicm_ode_step_type *T, dou
   const double start = sicm_stats_clock();
   r.ok = sicm_ode_evolve(o, &t, site.t1, r.final.data()) == SICM_SUCCESS;
   r.seconds = sicm_stats_clock() - start;
+  if (!r.ok) r.why_not = sicm_ode_last_error(o);
   if (site.time_first) r.final[0] = t; // the integrator's time, exactly
   r.work = *sicm_ode_get_stats(o);
   sicm_ode_free(o);
@@ -80,6 +85,8 @@ Run timed_run(const IntegrationSite &site, const std::string &method, double tol
   const sicm_ode_step_type *T = integrator_named(method);
   std::vector<double> times;
   Run r = integrate_once(site, T, tolerance);
+  r.method = method;
+  if (!r.ok) return r; // nothing to time
   times.push_back(r.seconds);
   int wanted = r.seconds < 1.0 ? std::max(repeats, kMinRepeatsOfShortRuns) : repeats;
   for (int k = 1; k < wanted; ++k)
@@ -276,6 +283,15 @@ int run_work_precision(const BenchOptions &options) {
     for (const std::string &m : methods)
       for (double tol : tolerances) {
         Run r = timed_run(site, m, tol, options.repeats);
+        // A run that failed says why. One that took no step at all (a
+        // fixed-step method refusing a step too small for the step limit)
+        // has no row; one that stopped on the way is a row of error inf
+        // with the state where it stopped.
+        if (!r.ok) {
+          std::printf("  %s for %s at %s: %s\n", r.work.steps == 0 ? "no row" : "stopped",
+                      m.c_str(), short_number(tol).c_str(), r.why_not.c_str());
+          if (r.work.steps == 0) continue;
+        }
         r.error = r.ok ? distance(r.final, reference.final) : INFINITY;
         tsv += site.where + "\t" + m + "\t" + short_number(tol) + "\t" + round_trip(r.seconds) +
                "\t" + std::to_string(r.work.steps) + "\t" + std::to_string(r.work.rhs_evals) +

@@ -86,12 +86,52 @@ TEST(Bench, ErrorsAgreeWithTheExactSolutionAndFailuresAreRows) {
   EXPECT_EQ(oscillator_rows, 3 * 8);
   EXPECT_EQ(stiff_rows, 3 * 8);
   EXPECT_GT(failed_rows, 0);
+  // Each failure says why on stdout.
+  std::ifstream printed(dir / "stdout.txt");
+  std::stringstream text;
+  text << printed.rdbuf();
+  EXPECT_NE(text.str().find("  stopped for rk8pd at "), std::string::npos) << text.str();
 
   // The diagram is well-formed XML (checked by Python's parser, which CI has).
   std::string check =
       "python3 -c \"import xml.dom.minidom,sys; xml.dom.minidom.parse(sys.argv[1])\" " +
       (out / "work-precision.svg").string();
   EXPECT_EQ(std::system(check.c_str()), 0);
+  std::error_code ignored;
+  fs::remove_all(dir, ignored);
+}
+
+// A fixed-step method whose step (its tolerance) would need more steps than
+// the limit takes none: no row, and a line saying why (it was a silent row
+// of error inf and 0 steps).
+TEST(Bench, AFixedStepMethodThatCannotStartSaysWhyAndHasNoRow) {
+  struct stat st;
+  if (stat(sicm_binary(), &st) != 0) GTEST_SKIP() << "no sicm binary at " << sicm_binary();
+  char tmpl[] = "/tmp/sicm-bench-test-XXXXXX";
+  ASSERT_NE(mkdtemp(tmpl), nullptr);
+  const fs::path dir = tmpl;
+  std::ofstream(dir / "spring.sicm")
+      << "(define ((spring k) s) (up 1 (ref s 2) (- (* k (ref s 1)))))\n"
+         "((state-advancer spring 1.) (up 0. 0. 1.) 10. 1e-10)\n";
+  const fs::path out = dir / "out";
+  std::string command = std::string(sicm_binary()) + " bench " + (dir / "spring.sicm").string() +
+                        " --out " + out.string() +
+                        " --methods verlet --tolerances 1e-4:1e-5 --repeats 1 > " +
+                        (dir / "stdout.txt").string() + " 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  std::ifstream printed(dir / "stdout.txt");
+  std::stringstream text;
+  text << printed.rdbuf();
+  EXPECT_NE(text.str().find("  no row for verlet at 1e-05: verlet: too many steps at t = 0. with "
+                            "state [0., 0., 1.]: 1000000 steps of 1e-05 are needed and the limit "
+                            "is 500000 (for verlet the tolerance argument is the step size)\n"),
+            std::string::npos)
+      << text.str();
+  std::ifstream tsv(out / "work-precision.tsv");
+  int rows = 0;
+  for (std::string line; std::getline(tsv, line);)
+    rows += line.find("\tverlet\t") != std::string::npos;
+  EXPECT_EQ(rows, 1); // 1e-4 only
   std::error_code ignored;
   fs::remove_all(dir, ignored);
 }
