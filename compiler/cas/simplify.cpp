@@ -98,6 +98,7 @@ ExprId simplify_kernel(ExprId id);
 bool root_out_squares(ExprId x, ExprId *out);
 bool split_root(ExprId x, ExprId *out);
 bool root_of_rational(ExprId x, ExprId *out);
+bool atan_common_factor(ExprId y, ExprId x, ExprId *out);
 
 // ---- kernels -------------------------------------------------------------------
 
@@ -258,6 +259,7 @@ ExprId kernel_rules(Op op, const std::vector<ExprId> &args) {
     if (args.size() == 2 && is_op1(x, Op::Sin) && is_op1(args[1], Op::Cos) &&
         expr_arg(x, 0) == expr_arg(args[1], 0))
       return expr_arg(x, 0);
+    if (args.size() == 2 && atan_common_factor(x, args[1], &out)) return out;
     break;
   case Op::Sqrt:
     if (root_of_rational(x, &out) || split_root(x, &out) || root_out_squares(x, &out)) return out;
@@ -961,6 +963,33 @@ bool split_root(ExprId x, ExprId *out) {
     over = expr_apply(Op::Div, {over, under});
   }
   *out = simplify_expr(over);
+  return true;
+}
+
+// (atan (* g y) (* g x)) is (atan y x) for g the greatest common divisor of
+// two polynomials (monic, so a number is never divided out), as scmutils'
+// atan rule divides by (gcd y x) with aggressive-atan-simplify on (its
+// default): this assumes g > 0, which keeps the quadrant. So
+// (atan (* r (sin phi)) (* r (cos phi))) is phi.
+bool atan_common_factor(ExprId y, ExprId x, ExprId *out) {
+  if (expr_is_number(y) || expr_is_number(x)) return false;
+  Pass pass;
+  pass.collect(y);
+  pass.collect(x);
+  const PolyRing &ring = pass.make_ring();
+  RatFun fy = pass.convert(y), fx = pass.convert(x);
+  if (!fy.is_polynomial() || !fx.is_polynomial() || fy.is_zero() || fx.is_zero()) return false;
+  Poly g(ring);
+  if (!fmpq_mpoly_gcd(g.get(), fy.num.get(), fx.num.get(), ring.ctx()) ||
+      fmpq_mpoly_is_fmpq(g.get(), ring.ctx()))
+    return false;
+  Poly qy(ring), qx(ring), one(ring);
+  fmpq_mpoly_div(qy.get(), fy.num.get(), g.get(), ring.ctx());
+  fmpq_mpoly_div(qx.get(), fx.num.get(), g.get(), ring.ctx());
+  fmpq_mpoly_one(one.get(), ring.ctx());
+  ExprId ny = rf_to_expr(RatFun(std::move(qy), one), pass.inexact());
+  ExprId nx = rf_to_expr(RatFun(std::move(qx), std::move(one)), pass.inexact());
+  *out = simplify_expr(expr_apply(Op::Atan, {ny, nx}));
   return true;
 }
 

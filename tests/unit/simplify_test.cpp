@@ -196,6 +196,18 @@ TEST(Simplify, RootsOfProductsAndQuotients) {
   EXPECT_EQ(pe(fn(Op::Sqrt, mul({F(2.5), x}))), "(sqrt (* 2.5 x))");
 }
 
+// scmutils' atan rule divides both arguments by their gcd (assuming it
+// positive, aggressive-atan-simplify): the polar-canonical inverse of the
+// transformation gives theta back.
+TEST(Simplify, AtanDividesOutACommonFactor) {
+  Value x = S("x"), y = S("y"), r = S("r"), phi = S("phi");
+  auto atan2 = [](Value a, Value b) { return apply(Op::Atan, {a, b}); };
+  EXPECT_EQ(pe(atan2(mul({r, fn(Op::Sin, phi)}), mul({r, fn(Op::Cos, phi)}))), "phi");
+  EXPECT_EQ(pe(atan2(mul({x, y}), mul({x, x}))), "(atan y x)");
+  EXPECT_EQ(pe(atan2(mul({N(2), y}), mul({N(2), x}))), "(atan (* 2 y) (* 2 x))");
+  EXPECT_EQ(pe(atan2(y, x)), "(atan y x)");
+}
+
 TEST(Simplify, NumbersFoldAsSchemeDoes) {
   EXPECT_EQ(pe(add({N(1), N(2)})), "3");
   EXPECT_EQ(pe(fn(Op::Sin, N(0))), "0");
