@@ -33,7 +33,10 @@
 // (scmutils' exp-expand, so equal values get one form and products of
 // exponentials cancel); (log (sqrt x)) is
 // (* 1/2 (log x)); (expt u p/2) is a power of (sqrt u); (sqrt (* f^2 g)) is
-// (* f (sqrt g)).
+// (* f (sqrt g)); the root of a product or quotient is the product or
+// quotient of the roots of its factors, as scmutils' sqrt-expand leaves it
+// (split_root), so products and quotients of roots combine; atan's two
+// arguments lose their common factor.
 //
 // Flonums. Coefficients are computed exactly (a flonum is the rational it
 // denotes) and, when the rational skeleton of the input contained a flonum,
@@ -44,7 +47,8 @@
 // Limits. No factorization: a numerator or denominator is an expanded
 // polynomial, as in scmutils. Like scmutils (sqrt-expt-simplify, its
 // default) square factors leave square roots on the assumption that they are
-// non-negative: (sqrt (expt r 2)) is r.
+// non-negative: (sqrt (expt r 2)) is r; and (sqrt-factor-simplify) that
+// the factors of a radicand are: (sqrt (* x y)) is (* (sqrt x) (sqrt y)).
 // Trig identities other than sin^2 + cos^2 = 1 (multiple angles, tan as
 // sin/cos) are not applied. The memo table only grows; it is indexed by id.
 #include "cas/simplify.hpp"
