@@ -246,10 +246,13 @@ Value prim_s_map_r(Value *args, int n) {
 }
 
 // Fresh literal numbers for compatible-shape and typical-object: x100, x101,
-// ... (scmutils generates uninterned symbols with such names).
+// ... Uninterned, as scmutils' generate-uninterned-symbol makes them: a
+// user's own 'x101 is another symbol, and a result still holding one of
+// these (a residual that is not zero, as the book's non-canonical transform
+// prints) can be told from the user's symbols (tests/unit/generated_names_test.cpp).
 Value fresh_symbol() {
   static uint64_t counter = 100;
-  return intern("x" + std::to_string(counter++));
+  return make_uninterned_symbol("x" + std::to_string(counter++));
 }
 
 Value fresh_leaves(Value shape, bool dual) {

@@ -421,6 +421,32 @@ void poly_split_square(const Poly &p, fmpq_t constant, Poly *root, Poly *rest) {
   fmpq_mpoly_factor_clear(f, ctx);
 }
 
+void poly_split_root_factors(const Poly &p, fmpq_t constant, Poly *root, Poly *monomial,
+                             Poly *rest) {
+  const fmpq_mpoly_ctx_struct *ctx = p.ctx();
+  poly_split_square(p, constant, root, rest);
+  fmpq_mpoly_one(monomial->get(), ctx);
+  if (rest->is_zero() || rest->is_one()) return;
+  fmpq_mpoly_term_content(monomial->get(), rest->get(), ctx);
+  fmpq_mpoly_divides(rest->get(), rest->get(), monomial->get(), ctx);
+  fmpq_t c;
+  fmpq_init(c);
+  if (fmpq_mpoly_is_fmpq(rest->get(), ctx)) {
+    fmpq_mpoly_get_fmpq(c, rest->get(), ctx);
+    fmpq_mpoly_one(rest->get(), ctx);
+  } else {
+    fmpq_mpoly_content(c, rest->get(), ctx); // positive
+    fmpq_t lead;
+    fmpq_init(lead);
+    fmpq_mpoly_get_term_coeff_fmpq(lead, rest->get(), 0, ctx);
+    if (fmpq_sgn(lead) < 0) fmpq_neg(c, c);
+    fmpq_clear(lead);
+    fmpq_mpoly_scalar_div_fmpq(rest->get(), rest->get(), c, ctx);
+  }
+  fmpq_mul(constant, constant, c);
+  fmpq_clear(c);
+}
+
 long poly_degree_in(const Poly &p, int v) {
   if (p.is_zero()) return 0;
   return fmpq_mpoly_degree_si(p.get(), v, p.ctx());

@@ -94,6 +94,13 @@ RatFun rf_reduce_square(const RatFun &f, int v, const RatFun &square);
 // factorization finds: rest is the product of the factors of p of odd
 // multiplicity; root and rest have no constant factor of their own.
 void poly_split_square(const Poly &p, fmpq_t constant, Poly *root, Poly *rest);
+// p = constant * root^2 * monomial * rest: poly_split_square's split, then
+// rest's monomial factor (the gcd of its terms, coefficient 1, each variable
+// to the first power) taken out of it and rest made primitive with integer
+// coefficients and a positive leading coefficient, its content and sign going
+// into constant. So rest is 1 or a polynomial of two terms or more.
+void poly_split_root_factors(const Poly &p, fmpq_t constant, Poly *root, Poly *monomial,
+                             Poly *rest);
 
 // Highest power of variable v in p (0 if absent).
 long poly_degree_in(const Poly &p, int v);

@@ -33,7 +33,10 @@
 // (scmutils' exp-expand, so equal values get one form and products of
 // exponentials cancel); (log (sqrt x)) is
 // (* 1/2 (log x)); (expt u p/2) is a power of (sqrt u); (sqrt (* f^2 g)) is
-// (* f (sqrt g)).
+// (* f (sqrt g)); the root of a product or quotient is the product or
+// quotient of the roots of its factors, as scmutils' sqrt-expand leaves it
+// (split_root), so products and quotients of roots combine; atan's two
+// arguments lose their common factor.
 //
 // Flonums. Coefficients are computed exactly (a flonum is the rational it
 // denotes) and, when the rational skeleton of the input contained a flonum,
@@ -44,7 +47,8 @@
 // Limits. No factorization: a numerator or denominator is an expanded
 // polynomial, as in scmutils. Like scmutils (sqrt-expt-simplify, its
 // default) square factors leave square roots on the assumption that they are
-// non-negative: (sqrt (expt r 2)) is r.
+// non-negative: (sqrt (expt r 2)) is r; and (sqrt-factor-simplify) that
+// the factors of a radicand are: (sqrt (* x y)) is (* (sqrt x) (sqrt y)).
 // Trig identities other than sin^2 + cos^2 = 1 (multiple angles, tan as
 // sin/cos) are not applied. The memo table only grows; it is indexed by id.
 #include "cas/simplify.hpp"
@@ -96,6 +100,9 @@ void memo_put(ExprId id, ExprId value) {
 
 ExprId simplify_kernel(ExprId id);
 bool root_out_squares(ExprId x, ExprId *out);
+bool split_root(ExprId x, ExprId *out);
+bool root_of_rational(ExprId x, ExprId *out);
+bool atan_common_factor(ExprId y, ExprId x, ExprId *out);
 
 // ---- kernels -------------------------------------------------------------------
 
@@ -256,9 +263,10 @@ ExprId kernel_rules(Op op, const std::vector<ExprId> &args) {
     if (args.size() == 2 && is_op1(x, Op::Sin) && is_op1(args[1], Op::Cos) &&
         expr_arg(x, 0) == expr_arg(args[1], 0))
       return expr_arg(x, 0);
+    if (args.size() == 2 && atan_common_factor(x, args[1], &out)) return out;
     break;
   case Op::Sqrt:
-    if (root_out_squares(x, &out)) return out;
+    if (root_of_rational(x, &out) || split_root(x, &out) || root_out_squares(x, &out)) return out;
     break;
   case Op::Exp:
     if (expand_exp(x, &out)) return out;
@@ -871,6 +879,163 @@ bool root_out_squares(ExprId x, ExprId *out) {
   }
   fmpq_clear(c);
   fmpq_clear(cd);
+  return changed;
+}
+
+// scmutils' simplifier ends its work on square roots (new-simplify in
+// simplify/rules.scm: sqrt-contract until stable, root-out-squares, then
+// sqrt-expand until stable) with them expanded: (sqrt (* x y)) is
+// (* (sqrt x) (sqrt y)) and (sqrt (/ x y)) is (/ (sqrt x) (sqrt y)), on its
+// assumption (sqrt-factor-simplify, on by default) that the factors are
+// non-negative. This is that final form, reached in one step: the radicand,
+// its square factors taken out (root-out-squares), is
+//   c * v1 ... vk * P / (w1 ... wl * Q)
+// with c a positive rational, the v and w variables (symbols or kernels)
+// and P and Q polynomials of two terms or more with no monomial factor,
+// and its root is the product (sqrt c) (sqrt v1) ... (sqrt P) over
+// (sqrt w1) ... (sqrt Q). Every product or quotient of square roots then
+// contracts in the rational function as sqrt(u)^2 = u does:
+// (* (sqrt (* 2 I alpha)) (sqrt (/ (* 2 I) alpha))) is (* 2 I), which is
+// what contracting with sqrt-contract and rooting out the square gives.
+// The sign of c goes into P (or Q): (sqrt (- 1 (expt x 2))) stays whole.
+// A radicand whose sign is its monomial's, (sqrt (* -1 x)), is not split
+// (scmutils' rule does not split a negative factor off), nor one with
+// flonums (whose numeric root would be a flonum kernel).
+// The value is unchanged up to the sign of each root of the input, and
+// equal under scmutils' assumption; every root of the input becomes one
+// product of roots, so a choice of signs of the input's roots gives the
+// output's value (the fuzz target's property 5).
+bool split_root(ExprId x, ExprId *out) {
+  if (expr_is_number(x) || expr_is_variable(x)) return false;
+  Pass pass;
+  pass.collect(x);
+  const PolyRing &ring = pass.make_ring();
+  if (pass.inexact()) return false;
+  RatFun f = pass.convert(x);
+  Poly num_root(ring), num_mono(ring), num_rest(ring);
+  Poly den_root(ring), den_mono(ring), den_rest(ring);
+  fmpq_t c, cd;
+  fmpq_init(c);
+  fmpq_init(cd);
+  poly_split_root_factors(f.num, c, &num_root, &num_mono, &num_rest);
+  poly_split_root_factors(f.den, cd, &den_root, &den_mono, &den_rest);
+  fmpq_div(c, c, cd);
+  bool split = true;
+  if (fmpq_sgn(c) < 0) {
+    Poly *signed_rest = !num_rest.is_one() ? &num_rest : !den_rest.is_one() ? &den_rest : nullptr;
+    if (signed_rest)
+      fmpq_mpoly_neg(signed_rest->get(), signed_rest->get(), ring.ctx());
+    else
+      split = false;
+    fmpq_neg(c, c);
+  }
+  // The roots over and under the line.
+  std::vector<ExprId> up, down;
+  auto roots_of = [&](const Poly &mono, const Poly &rest, std::vector<ExprId> *roots) {
+    std::vector<ulong> e(std::max<size_t>(ring.nvars(), 1));
+    if (!mono.is_one()) {
+      fmpq_mpoly_get_term_exp_ui(e.data(), mono.get(), 0, ring.ctx());
+      for (size_t i = 0; i < ring.nvars(); i++) {
+        if (e[i] > 1) split = false; // not squarefree: cannot happen, but be safe
+        if (e[i] == 1) roots->push_back(expr_apply(Op::Sqrt, {ring.var(i)}));
+      }
+    }
+    if (!rest.is_one()) {
+      Poly one(ring);
+      fmpq_mpoly_one(one.get(), ring.ctx());
+      roots->push_back(expr_apply(Op::Sqrt, {rf_to_expr(RatFun(rest, std::move(one)), false)}));
+    }
+  };
+  roots_of(num_mono, num_rest, &up);
+  roots_of(den_mono, den_rest, &down);
+  if (!fmpq_is_one(c)) {
+    mpq_t q;
+    mpq_init(q);
+    fmpq_get_mpq(q, c);
+    up.push_back(expr_apply(Op::Sqrt, {expr_rational(q)}));
+    mpq_clear(q);
+  }
+  bool whole = num_root.is_one() && den_root.is_one() && down.empty() && up.size() <= 1;
+  fmpq_clear(c);
+  fmpq_clear(cd);
+  if (!split || whole) return false;
+  ExprId outside = rf_to_expr(RatFun(std::move(num_root), std::move(den_root)), false);
+  up.push_back(outside);
+  ExprId over = up.size() == 1 ? up[0] : expr_apply(Op::Mul, up.data(), up.size());
+  if (!down.empty()) {
+    ExprId under = down.size() == 1 ? down[0] : expr_apply(Op::Mul, down.data(), down.size());
+    over = expr_apply(Op::Div, {over, under});
+  }
+  *out = simplify_expr(over);
+  return true;
+}
+
+// (atan (* g y) (* g x)) is (atan y x) for g the greatest common divisor of
+// two polynomials (monic, so a number is never divided out), as scmutils'
+// atan rule divides by (gcd y x) with aggressive-atan-simplify on (its
+// default): this assumes g > 0, which keeps the quadrant. So
+// (atan (* r (sin phi)) (* r (cos phi))) is phi.
+bool atan_common_factor(ExprId y, ExprId x, ExprId *out) {
+  if (expr_is_number(y) || expr_is_number(x)) return false;
+  Pass pass;
+  pass.collect(y);
+  pass.collect(x);
+  const PolyRing &ring = pass.make_ring();
+  RatFun fy = pass.convert(y), fx = pass.convert(x);
+  if (!fy.is_polynomial() || !fx.is_polynomial() || fy.is_zero() || fx.is_zero()) return false;
+  Poly g(ring);
+  if (!fmpq_mpoly_gcd(g.get(), fy.num.get(), fx.num.get(), ring.ctx()) ||
+      fmpq_mpoly_is_fmpq(g.get(), ring.ctx()))
+    return false;
+  Poly qy(ring), qx(ring), one(ring);
+  fmpq_mpoly_div(qy.get(), fy.num.get(), g.get(), ring.ctx());
+  fmpq_mpoly_div(qx.get(), fx.num.get(), g.get(), ring.ctx());
+  fmpq_mpoly_one(one.get(), ring.ctx());
+  ExprId ny = rf_to_expr(RatFun(std::move(qy), one), pass.inexact());
+  ExprId nx = rf_to_expr(RatFun(std::move(qx), std::move(one)), pass.inexact());
+  *out = simplify_expr(expr_apply(Op::Atan, {ny, nx}));
+  return true;
+}
+
+// The square root of a positive exact rational that is not a square, as
+// scmutils' root-out-squares leaves it and then some: its denominator moved
+// out, sqrt(p/q) = sqrt(pq)/q, and the squares of small primes taken out of
+// pq, so (sqrt 8) is (* 2 (sqrt 2)) and (sqrt 1/2) is (* 1/2 (sqrt 2)), and
+// (* (sqrt 8) (sqrt 2)) is 4. (Larger square factors stay inside: finding
+// them is factoring.)
+constexpr unsigned long kMaxRootTrialDivisor = 1000;
+bool root_of_rational(ExprId x, ExprId *out) {
+  if (expr_kind(x) != ExprKind::Rational || mpq_sgn(expr_rat(x)) <= 0) return false;
+  mpz_t n, outside, d2;
+  mpz_init(n);
+  mpz_init_set_ui(outside, 1);
+  mpz_init(d2);
+  mpz_mul(n, mpq_numref(expr_rat(x)), mpq_denref(expr_rat(x)));
+  for (unsigned long d = 2; d <= kMaxRootTrialDivisor; d++) {
+    mpz_set_ui(d2, d * d);
+    if (mpz_cmp(d2, n) > 0) break;
+    while (mpz_divisible_p(n, d2)) {
+      mpz_divexact(n, n, d2);
+      mpz_mul_ui(outside, outside, d);
+    }
+  }
+  bool changed = mpz_cmp_ui(outside, 1) != 0 || mpz_cmp_ui(mpq_denref(expr_rat(x)), 1) != 0;
+  if (changed) {
+    mpq_t factor, radicand;
+    mpq_init(factor);
+    mpq_init(radicand);
+    mpz_set(mpq_numref(factor), outside);
+    mpz_set(mpq_denref(factor), mpq_denref(expr_rat(x)));
+    mpq_canonicalize(factor);
+    mpq_set_z(radicand, n);
+    ExprId f = expr_rational(factor), r = expr_rational(radicand);
+    *out = simplify_expr(expr_apply(Op::Mul, {f, expr_apply(Op::Sqrt, {r})}));
+    mpq_clear(factor);
+    mpq_clear(radicand);
+  }
+  mpz_clear(n);
+  mpz_clear(outside);
+  mpz_clear(d2);
   return changed;
 }
 

@@ -154,6 +154,60 @@ TEST(Simplify, RootsExpAndLog) {
   EXPECT_EQ(pe(fn(Op::Exp, mul({N(2), fn(Op::Log, x)}))), "(expt x 2)");
 }
 
+// Square roots end expanded, as scmutils' new-simplify leaves them (its
+// last sqrt step is sqrt-expand, after sqrt-contract and root-out-squares),
+// so products and quotients of roots combine: the polar-canonical
+// transformation's (* (sqrt (* 2 I alpha)) (sqrt (/ (* 2 I) alpha))) is 2I.
+TEST(Simplify, RootsOfProductsAndQuotients) {
+  Value x = S("x"), y = S("y"), I = S("I"), alpha = S("alpha");
+  EXPECT_EQ(pe(fn(Op::Sqrt, mul({x, y}))), "(* (sqrt x) (sqrt y))");
+  EXPECT_EQ(pe(fn(Op::Sqrt, div({x, y}))), "(/ (sqrt x) (sqrt y))");
+  EXPECT_EQ(pe(fn(Op::Sqrt, div({N(1), x}))), "(/ 1 (sqrt x))");
+  EXPECT_EQ(pe(fn(Op::Sqrt, mul({N(2), x}))), "(* (sqrt 2) (sqrt x))");
+  Value p = fn(Op::Sqrt, mul({N(2), I, alpha}));
+  Value q = fn(Op::Sqrt, div({mul({N(2), I}), alpha}));
+  EXPECT_EQ(pe(mul({p, q})), "(* 2 I)");
+  EXPECT_EQ(pe(sub({mul({p, q}), mul({N(2), I})})), "0");
+  EXPECT_EQ(pe(div({p, q})), "alpha");
+  EXPECT_EQ(pe(sub({fn(Op::Sqrt, mul({x, y})), mul({fn(Op::Sqrt, x), fn(Op::Sqrt, y)})})), "0");
+  EXPECT_EQ(pe(sub({fn(Op::Sqrt, div({x, y})), div({fn(Op::Sqrt, x), fn(Op::Sqrt, y)})})), "0");
+  // Squares and perfect powers leave the root (root-out-squares, assuming
+  // them non-negative as sqrt-expt-simplify does).
+  EXPECT_EQ(pe(fn(Op::Sqrt, mul({expt(x, N(3)), y}))), "(* x (sqrt x) (sqrt y))");
+  EXPECT_EQ(pe(fn(Op::Sqrt, div({expt(x, N(4)), expt(y, N(2))}))), "(/ (expt x 2) y)");
+  EXPECT_EQ(pe(fn(Op::Sqrt, expt(add({x, y}), N(2)))), "(+ x y)");
+  // A polynomial's content and monomial factor leave it; the rest stays one root.
+  EXPECT_EQ(pe(fn(Op::Sqrt, add({mul({N(2), x}), mul({N(2), y})}))), "(* (sqrt 2) (sqrt (+ x y)))");
+  EXPECT_EQ(pe(fn(Op::Sqrt, add({mul({x, x, y}), mul({x, y, y})}))),
+            "(* (sqrt x) (sqrt y) (sqrt (+ x y)))");
+  // Exact numbers: the denominator and small square factors move out.
+  Value eight = add({x, N(8), mul({N(-1), x})}), two = add({x, N(2), mul({N(-1), x})});
+  EXPECT_EQ(pe(fn(Op::Sqrt, eight)), "(* 2 (sqrt 2))");
+  EXPECT_EQ(pe(mul({fn(Op::Sqrt, eight), fn(Op::Sqrt, two)})), "4");
+  EXPECT_EQ(pe(fn(Op::Sqrt, add({x, Q(1, 2), mul({N(-1), x})}))), "(* 1/2 (sqrt 2))");
+  // A negative sign is not split off: it stays with a polynomial factor,
+  // or the root stays whole.
+  Value one_minus_x2 = sub({N(1), square(x)});
+  EXPECT_EQ(pe(fn(Op::Sqrt, one_minus_x2)), "(sqrt (+ 1 (* -1 (expt x 2))))");
+  EXPECT_EQ(pe(fn(Op::Sqrt, div({one_minus_x2, y}))),
+            "(/ (sqrt (+ 1 (* -1 (expt x 2)))) (sqrt y))");
+  EXPECT_EQ(pe(fn(Op::Sqrt, mul({N(-2), x, y}))), "(sqrt (* -2 x y))");
+  // With flonums the radicand stays whole: its root would be a flonum kernel.
+  EXPECT_EQ(pe(fn(Op::Sqrt, mul({F(2.5), x}))), "(sqrt (* 2.5 x))");
+}
+
+// scmutils' atan rule divides both arguments by their gcd (assuming it
+// positive, aggressive-atan-simplify): the polar-canonical inverse of the
+// transformation gives theta back.
+TEST(Simplify, AtanDividesOutACommonFactor) {
+  Value x = S("x"), y = S("y"), r = S("r"), phi = S("phi");
+  auto atan2 = [](Value a, Value b) { return apply(Op::Atan, {a, b}); };
+  EXPECT_EQ(pe(atan2(mul({r, fn(Op::Sin, phi)}), mul({r, fn(Op::Cos, phi)}))), "phi");
+  EXPECT_EQ(pe(atan2(mul({x, y}), mul({x, x}))), "(atan y x)");
+  EXPECT_EQ(pe(atan2(mul({N(2), y}), mul({N(2), x}))), "(atan (* 2 y) (* 2 x))");
+  EXPECT_EQ(pe(atan2(y, x)), "(atan y x)");
+}
+
 TEST(Simplify, NumbersFoldAsSchemeDoes) {
   EXPECT_EQ(pe(add({N(1), N(2)})), "3");
   EXPECT_EQ(pe(fn(Op::Sin, N(0))), "0");
