@@ -17,4 +17,10 @@ void set_datum_converter(Tag tag, DatumConverter convert);
 std::string write_string(Value v);
 std::string display_string(Value v);
 
+// Print uninterned symbols -- the names the system makes for itself
+// (compatible-shape's literals, kernel parameters) -- marked «so», for the
+// test runner to find any that reaches a result. On when the environment
+// has SICM_MARK_GENERATED_NAMES (tests/run sets it), else off.
+void set_mark_generated_names(bool on);
+
 } // namespace sicm

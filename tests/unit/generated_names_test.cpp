@@ -123,4 +123,19 @@ TEST(GeneratedNames, SeenInANonCanonicalResidual) {
   EXPECT_FALSE(holds_generated_name(run("(+ 'x101 'x102)")));
 }
 
+// Under the test runner (SICM_MARK_GENERATED_NAMES, tests/run) a generated
+// name prints marked, so that every test's output is searched for one; a
+// user's symbol of the same spelling prints as written.
+TEST(GeneratedNames, PrintMarkedForTheTestRunner) {
+  run(kDefinitions);
+  Value residual =
+      run("((time-independent-canonical? a-non-canonical-transform) (up 't 'theta 'p))");
+  set_mark_generated_names(true);
+  const std::string marked = write_string(residual), user = write_string(run("(list 'x101)"));
+  set_mark_generated_names(false);
+  EXPECT_NE(marked.find("\u00abx"), std::string::npos) << marked;
+  EXPECT_EQ(user, "(x101)");
+  EXPECT_EQ(write_string(residual).find("\u00ab"), std::string::npos);
+}
+
 } // namespace
