@@ -50,6 +50,12 @@ using TopLevelProbe = bool (*)();
 void set_top_level_probe(TopLevelProbe probe);
 bool raised_at_top_level();
 
+// The note of every "cannot compile" error. The driver adds what `sicm run`
+// does with the program (driver/run_check.hpp): it says "`sicm run`
+// interprets this program" only where it does.
+inline constexpr const char *kCannotCompileNote =
+    "sicm build leaves only numerical work for run time";
+
 struct Error : std::runtime_error {
   ErrorKind kind;
   ErrorCause cause = ErrorCause::Other;

@@ -61,8 +61,7 @@ void refuse_run_time_argument(Value obj, int argpos, const char *who) {
                   (number ? "a number known only at run time"
                           : "a value that holds numbers known only at run time") +
                   " (its " + ordinal(argpos) + " argument)",
-              "sicm build leaves only numerical work for run time; `sicm run` interprets this "
-              "program");
+              kCannotCompileNote);
 }
 
 } // namespace

@@ -24,6 +24,7 @@
 #include "driver/init.hpp"
 #include "driver/pipeline.hpp"
 #include "driver/repl.hpp"
+#include "driver/run_check.hpp"
 #include "eval/core.hpp"
 #include "eval/interp.hpp"
 #include "eval/procedure.hpp"
@@ -95,6 +96,13 @@ const char kUsage[] =
     "--max-steps, --max-memory, --max-expression-nodes, --max-recursion-depth,\n"
     "--max-residual-size, and for build the unroll limits --max-unrolled-elements\n"
     "and --max-unrolled-iterations (sicm --help lists their defaults)\n";
+
+// The program `sicm build` (or emit-c, report) is compiling, for the note
+// of a "cannot compile" error (driver/run_check.hpp); empty otherwise.
+std::string g_build_input;
+// How long `sicm run` may run a program the build refused before the note
+// says only that it ran that long without failing.
+constexpr double kRunCheckSeconds = 10;
 
 struct Job {
   std::vector<std::string> args;
@@ -248,6 +256,7 @@ int dispatch(const std::vector<std::string> &args) {
       if (o.output == o.input) o.output += ".out";
     }
     if (want_report && o.report_path.empty()) o.report_path = o.output + ".report.json";
+    g_build_input = o.input;
     return sicm::build_program(o);
   }
   if (cmd == "run") {
@@ -293,7 +302,13 @@ void *evaluator_thread(void *arg) {
     job->status = dispatch(job->args);
   } catch (const sicm::Error &e) {
     sicm::flush_output();
-    sicm::report_error(stderr, sicm::as_users_error(e));
+    sicm::Error shown = sicm::as_users_error(e);
+    // A program the build refuses: say what sicm run does with it.
+    if (e.cause == sicm::ErrorCause::CannotCompile && !g_build_input.empty())
+      if (std::string does = sicm::what_sicm_run_does(g_build_input, kRunCheckSeconds);
+          !does.empty())
+        shown.note += (shown.note.empty() ? "" : "; ") + does;
+    sicm::report_error(stderr, shown);
     job->status = e.exit_code();
   } catch (const std::bad_alloc &) {
     sicm::flush_output();

@@ -86,8 +86,7 @@ const char kMarkerSuffix[] = "__";
 
 [[noreturn]] void cannot_compile(SrcLoc loc, const std::string &what) {
   throw Error(ErrorKind::Syntax, ErrorCause::CannotCompile, loc, "cannot compile: " + what,
-              "sicm build leaves only numerical work for run time; `sicm run` interprets this "
-              "program");
+              kCannotCompileNote);
 }
 
 BuildState *g_build = nullptr;
