@@ -9,6 +9,8 @@
 #include <functional>
 #include <string>
 
+#include "algebra/differential.hpp"
+#include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
 #include "base/number.hpp"
 #include "eval/core.hpp"
@@ -37,9 +39,25 @@ bool block_calls(const std::vector<RStmt> &block) {
   return false;
 }
 
-namespace {} // namespace
-
 namespace {
+
+bool is_inexact_scalar(Value v) {
+  return v.is(Tag::Flonum) || (is_dynamic_scalar(v) && scalar_type(v) == RType::Real);
+}
+
+// Two differentials chosen between term by term. A term one of them lacks
+// is an exact 0 of the other's kind: the derivative of a constant arm ((if
+// (> x 0) (* 1/2 k x x) 0)) is as inexact as the other arm's, since which
+// arm holds is known only at run time.
+Value select_differentials(Value test, Value a, Value b) {
+  return combine_differential_terms(a, b, [&](Value x, Value y) {
+    if (is_exact_zero(x) && is_inexact_scalar(y)) x = Value::flonum(0.0);
+    if (is_exact_zero(y) && is_inexact_scalar(x)) y = Value::flonum(0.0);
+    return select_values(test, x, y);
+  });
+}
+
+} // namespace
 
 // The value that is `a` when test holds at run time and `b` otherwise.
 Value select_values(Value test, Value a, Value b) {
@@ -69,6 +87,7 @@ Value select_values(Value test, Value a, Value b) {
   }
   if (is_pair(a) && is_pair(b))
     return cons(select_values(test, car(a), car(b)), select_values(test, cdr(a), cdr(b)));
+  if (is_differential(a) || is_differential(b)) return select_differentials(test, a, b);
   RtList *ra = as_rtlist(a), *rb = as_rtlist(b);
   if (ra && rb && ra->list == rb->list && ra->reversed == rb->reversed)
     return make_rtlist(ra->list, ra->reversed, false, select_values(test, ra->start, rb->start),
@@ -77,6 +96,8 @@ Value select_values(Value test, Value a, Value b) {
                              describe(a) + " and " + describe(b) +
                              ", which cannot be chosen between at run time");
 }
+
+namespace {
 
 // Evaluate one alternative under a run-time test.
 Value speculate(const std::function<Value()> &alternative) {

@@ -61,6 +61,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "algebra/differential.hpp"
 #include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
 #include "base/limits.hpp"
@@ -489,9 +490,20 @@ Value compare_chain(Value *a, int n, RCompute c, bool swap, const char *who) {
   return result;
 }
 
+// The arguments with each differential replaced by its finite part, which
+// is what a comparison compares (algebra/comparison.cpp): a test of a
+// differential on the state is a test of the state.
+gcvec<Value> finite_parts(Value *a, int n) {
+  gcvec<Value> out(a, a + n);
+  for (Value &v : out)
+    v = differential_finite_part(v);
+  return out;
+}
+
 template <const char *Name, RCompute C, bool Swap> Value P_compare(Value *a, int n) {
-  if (!any_dynamic(a, n)) return call_original(Name, a, n);
-  return compare_chain(a, n, C, Swap, Name);
+  gcvec<Value> finite = finite_parts(a, n);
+  if (!any_dynamic(finite.data(), n)) return call_original(Name, a, n);
+  return compare_chain(finite.data(), n, C, Swap, Name);
 }
 constexpr char kLess[] = "<";
 constexpr char kGreater[] = ">";
@@ -554,8 +566,11 @@ constexpr char kEqvP[] = "eqv?";
 constexpr char kEqualP[] = "equal?";
 
 template <const char *Name, RCompute C, bool Swap> Value P_sign_test(Value *a, int n) {
-  if (!any_dynamic(a, n)) return call_original(Name, a, n);
-  Value args[2] = {a[0], Value::fixnum(0)};
+  // zero? of a differential is not a test of its finite part (scmutils'
+  // diff:zero? asks whether every coefficient is 0): generic arithmetic's.
+  Value x = C == RCompute::Equal ? a[0] : differential_finite_part(a[0]);
+  if (!any_dynamic(&x, 1)) return call_original(Name, a, n);
+  Value args[2] = {x, Value::fixnum(0)};
   return compare_chain(args, 2, C, Swap, Name);
 }
 constexpr char kZero[] = "zero?";
@@ -570,8 +585,36 @@ constexpr char kFloor[] = "floor";
 constexpr char kRound[] = "round";
 constexpr char kTruncate[] = "truncate";
 
+// max or min of arguments among which are differentials whose finite parts
+// are known only at run time: the argument whose finite part is chosen,
+// selected at run time (algebra/comparison.cpp says what is chosen), with
+// every finite part inexact, since one is.
+Value choose_differential(Value *a, int n, bool max) {
+  gcvec<Value> args(a, a + n);
+  for (Value &v : args) {
+    Value f = differential_finite_part(v);
+    if (is_number(f) && !f.is(Tag::Flonum)) v = with_finite_part(v, num_exact_to_inexact(f));
+    if (is_number(v) && !v.is(Tag::Flonum)) v = num_exact_to_inexact(v);
+  }
+  Value best = args[0];
+  for (int i = 1; i < n; ++i) {
+    // max: a later argument replaces the best one if the best is less.
+    Value pair[2] = {differential_finite_part(max ? best : args[i]),
+                     differential_finite_part(max ? args[i] : best)};
+    Value test = compare_chain(pair, 2, RCompute::Less, false, "<");
+    if (!is_dynamic_boolean(test))
+      best = test.truthy() ? args[i] : best;
+    else
+      best = select_values(test, args[i], best);
+  }
+  return best;
+}
+
 template <const char *Name, RCompute C> Value P_fold(Value *a, int n) {
-  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  gcvec<Value> finite = finite_parts(a, n);
+  if (!any_dynamic(finite.data(), n)) return call_original(Name, a, n);
+  for (int i = 0; i < n; ++i)
+    if (is_differential(a[i])) return choose_differential(a, n, C == RCompute::Max);
   Value acc = a[0];
   for (int i = 1; i < n; ++i)
     acc = let(C, {expr_of(acc, Name), expr_of(a[i], Name)}, RType::Real);
@@ -831,7 +874,7 @@ ResidualProgram &BuildSession::program() {
 
 void BuildSession::fail_here(const Error &e) {
   SICM_ASSERT(build::g_build == state_ && e.at_top_level);
-  flush_output(); // what the program printed before, in its place
+  flush_output();                        // what the program printed before, in its place
   std::string message = format_error(e); // the bytes sicm run writes on stderr
   RStmt s{RKind::Fail};
   s.loc = e.loc;

@@ -226,6 +226,9 @@ void log_assignment(const Assignment &a);
 // Does the block call a function or add to a list (after which cells and
 // lists are read again)?
 bool block_calls(const std::vector<RStmt> &block);
+// The value that is `a` when the run-time truth value `test` holds and `b`
+// otherwise (numbers, structures, pairs, run-time lists, differentials).
+Value select_values(Value test, Value a, Value b);
 
 // The evaluator's hooks (DynamicBranchHooks in eval/procedure.hpp).
 bool hook_dynamic_test(Value test);
