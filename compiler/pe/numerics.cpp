@@ -681,9 +681,13 @@ void trace_singular_factors(Value state, RStmt &s) {
 
 // For the implicit methods, the Jacobian (D sysder) traced as a function of
 // the state too (its leaves: d f_i / d y_j at j * dim + i), as sicm run
-// compiles it; left to finite differences when it cannot be traced.
+// compiles it; left to finite differences when it cannot be traced, and,
+// as sicm run leaves it (builtins/numerics.cpp), when the derivative is not
+// a kernel: one that tests the state (whose Jacobian D now traces through
+// the test) integrates with the same steps in both.
 void trace_jacobian(Value sysder, Value state, RStmt &s) {
   if (s.method != "sicm_ode_step_msbdf" && s.method != "sicm_ode_step_cvode_bdf") return;
+  if (s.callee < 0 || !g_build->program.functions[s.callee].kernel) return;
   Symbol *d = intern("D").symbol();
   if (!d->bound) return;
   KernelTraceScope parameters;
