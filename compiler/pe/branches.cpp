@@ -45,16 +45,24 @@ bool is_inexact_scalar(Value v) {
   return v.is(Tag::Flonum) || (is_dynamic_scalar(v) && scalar_type(v) == RType::Real);
 }
 
-// Two differentials chosen between term by term. A term one of them lacks
-// is an exact 0 of the other's kind: the derivative of a constant arm ((if
-// (> x 0) (* 1/2 k x x) 0)) is as inexact as the other arm's, since which
-// arm holds is known only at run time.
+// Inside a system derivative (g_build->doubles_only), whose values end as
+// doubles, an exact 0 chosen against an inexact number is 0.: a potential
+// that is 0 on one side ((if (> x 0) (* 1/2 k x x) 0)), and the derivative
+// of such a constant arm, are as inexact as the other arm, since which arm
+// holds is known only at run time. Elsewhere (a value printed at the top
+// level, a monitor) the kinds must agree as the printed form depends on
+// them.
+void match_exact_zero(Value &a, Value &b) {
+  if (g_build->doubles_only == 0) return;
+  if (is_exact_zero(a) && is_inexact_scalar(b)) a = Value::flonum(0.0);
+  if (is_exact_zero(b) && is_inexact_scalar(a)) b = Value::flonum(0.0);
+}
+
+// Two differentials chosen between term by term; a term one of them lacks
+// is an exact 0.
 Value select_differentials(Value test, Value a, Value b) {
-  return combine_differential_terms(a, b, [&](Value x, Value y) {
-    if (is_exact_zero(x) && is_inexact_scalar(y)) x = Value::flonum(0.0);
-    if (is_exact_zero(y) && is_inexact_scalar(x)) y = Value::flonum(0.0);
-    return select_values(test, x, y);
-  });
+  return combine_differential_terms(a, b,
+                                    [&](Value x, Value y) { return select_values(test, x, y); });
 }
 
 } // namespace
@@ -70,6 +78,7 @@ Value select_values(Value test, Value a, Value b) {
     // The printed form depends on the kind of number, which must not
     // depend on the test: both truth values, both exact integers (or
     // counts), or both inexact.
+    match_exact_zero(a, b);
     RType ta = scalar_type(a), tb = scalar_type(b);
     if (ta != tb)
       cannot_compile(here(), "the alternatives of a test on a value known only at run time give " +

@@ -62,6 +62,7 @@
 #include <unordered_map>
 
 #include "algebra/differential.hpp"
+#include "algebra/generic.hpp"
 #include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
 #include "base/limits.hpp"
@@ -610,6 +611,25 @@ Value choose_differential(Value *a, int n, bool max) {
   return best;
 }
 
+// abs or magnitude of a differential whose finite part is known only at
+// run time: x or -x, chosen at run time by the sign of that part, as
+// algebra/differential.cpp chooses it for a number (scmutils' diff:abs), so
+// its coefficients keep their kinds where a value may be printed. Where the
+// part is 0 this gives x (sicm run's interpreter stops: no derivative
+// there). A system derivative is traced as sicm run traces its kernels, with
+// the slope x/|x| of generic arithmetic (g_build->doubles_only), so that
+// both compile the same kernel.
+template <const char *Name> Value P_abs(Value *a, int n) {
+  Value f = differential_finite_part(a[0]);
+  if (!is_differential(a[0]) || !is_dynamic_scalar(f) || g_build->doubles_only > 0)
+    return call_original(Name, a, n);
+  Value pair[2] = {f, Value::fixnum(0)};
+  Value negative = compare_chain(pair, 2, RCompute::Less, false, "<");
+  return select_values(negative, g_neg(a[0]), a[0]);
+}
+constexpr char kAbs[] = "abs";
+constexpr char kMagnitude[] = "magnitude";
+
 template <const char *Name, RCompute C> Value P_fold(Value *a, int n) {
   gcvec<Value> finite = finite_parts(a, n);
   if (!any_dynamic(finite.data(), n)) return call_original(Name, a, n);
@@ -751,7 +771,7 @@ const PrimFn p_zero_p = P_sign_test<kZero, RCompute::Equal, false>,
 const PrimFn p_floor = P_unary<kFloor, RCompute::Floor>, p_round = P_unary<kRound, RCompute::Round>,
              p_truncate = P_unary<kTruncate, RCompute::Truncate>,
              p_max = P_fold<kMax, RCompute::Max>, p_min = P_fold<kMin, RCompute::Min>,
-             p_not = P_not;
+             p_abs = P_abs<kAbs>, p_magnitude = P_abs<kMagnitude>, p_not = P_not;
 const PrimFn p_eq_p = P_same<kEqP, false>, p_eqv_p = P_same<kEqvP, false>,
              p_equal_p = P_same<kEqualP, true>;
 const PrimFn p_random = P_random, p_real_time = P_real_time, p_parameter = P_parameter,

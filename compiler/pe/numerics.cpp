@@ -581,6 +581,19 @@ struct NotShapedLikeState {};
 
 } // namespace
 
+namespace {
+
+// While it lives, the procedure being traced is one whose values end as
+// doubles (select_values in pe/branches.cpp).
+struct DoublesOnly {
+  DoublesOnly() { ++g_build->doubles_only; }
+  ~DoublesOnly() { --g_build->doubles_only; }
+  DoublesOnly(const DoublesOnly &) = delete;
+  DoublesOnly &operator=(const DoublesOnly &) = delete;
+};
+
+} // namespace
+
 // A system derivative traced into a new function of the state's leaves
 // whose outputs are the derivative's leaves, in the form the interpreter's
 // compiled derivatives take (kernel_outputs: evolve in `sicm run` compiles
@@ -595,6 +608,7 @@ struct NotShapedLikeState {};
 int trace_system_function(Value sysder, Value state, const char *who) {
   if (!is_state_shape(state)) wrong_type(state, 1, who);
   SrcLoc call = here(); // the integrator's call: the trace moves into sysder
+  DoublesOnly doubles;
   try {
     KernelTraceScope parameters;
     FunctionScope scope(procedure_name(sysder));
@@ -690,6 +704,7 @@ void trace_jacobian(Value sysder, Value state, RStmt &s) {
   if (s.callee < 0 || !g_build->program.functions[s.callee].kernel) return;
   Symbol *d = intern("D").symbol();
   if (!d->bound) return;
+  DoublesOnly doubles;
   KernelTraceScope parameters;
   try {
     FunctionScope scope("jacobian");

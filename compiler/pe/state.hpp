@@ -94,6 +94,10 @@ struct BuildState {
   std::vector<uint32_t> undo_serials;    // g_frame_serial when each log began
   long branch_evaluations = 0;           // alternatives evaluated under tests on run-time values
   std::vector<size_t> capture_depths;    // open.size() when each with-output-to-string began
+  // Traces of procedures whose values end as doubles (a system derivative
+  // and its Jacobian), nested: there an exact 0 chosen against an inexact
+  // number is 0. (select_values).
+  int doubles_only = 0;
 
   // ---- pe/lists.cpp
   std::vector<ListCell> list_cells; // the variables that hold run-time lists
