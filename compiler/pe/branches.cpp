@@ -83,7 +83,10 @@ Value select_values(Value test, Value a, Value b) {
     if (ta != tb)
       cannot_compile(here(), "the alternatives of a test on a value known only at run time give " +
                                  describe(a) + " and " + describe(b) +
-                                 ", numbers of different kinds (exact and inexact)");
+                                 ", numbers of different kinds (exact and inexact)" +
+                                 (is_exact_zero(a) || is_exact_zero(b)
+                                      ? " (write 0. for a zero that stands for a real number)"
+                                      : ""));
     return let(RCompute::Select, {expr_of(test, "if"), expr_of(a, "if"), expr_of(b, "if")}, ta);
   }
   if (is_structure(a) && is_structure(b) && as_structure(a)->up == as_structure(b)->up &&
