@@ -14,8 +14,6 @@
 // the finite parts, so errors name the same procedures (a symbol compared is
 // "passed as the first argument to integer-less?"). = and zero? are generic
 // arithmetic's (algebra/generic.cpp, differential.cpp).
-#include <string>
-
 #include "algebra/differential.hpp"
 #include "algebra/generic.hpp"
 #include "base/error.hpp"
