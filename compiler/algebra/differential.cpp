@@ -17,6 +17,8 @@
 
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
+#include "base/error.hpp"
+#include "base/number.hpp"
 #include "base/primitive.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
@@ -234,14 +236,40 @@ Value apply_on_group(Value x, long group, F f, Slope slope_of) {
   return from_terms(std::move(terms));
 }
 
+Value negate_terms(Value x) {
+  gcvec<DTerm> terms = terms_of(x);
+  for (DTerm &t : terms)
+    t.coef = g_neg(t.coef);
+  return from_terms(std::move(terms));
+}
+
+// scmutils' diff:abs: |x| is x or -x by the sign of x's finite part, and
+// has no derivative where that part is 0. A finite part that is not a
+// number (an expression, or a value sicm build knows only at run time) goes
+// through the chain rule with the slope x/|x|, which is that sign wherever
+// it is defined (scmutils refuses a literal number there).
+bool abs_by_sign(Value x, Value *out) {
+  Value f = differential_finite_part(x);
+  if (!is_real(f)) return false;
+  int sign = num_sign(f);
+  if (sign == 0) runtime_error(current_call_loc(), "Derivative of abs undefined at zero");
+  *out = sign < 0 ? negate_terms(x) : x;
+  return true;
+}
+
+// scmutils' diff:zero?: every coefficient, the finite part's and the
+// infinitesimals', is zero.
+bool all_terms_zero(Value x) {
+  for (const DTerm &t : terms_of(x))
+    if (!g_zero_p(t.coef)) return false;
+  return true;
+}
+
 Value diff_unary(UnaryOp op, Value x) {
-  if (op == UnaryOp::Neg) {
-    gcvec<DTerm> terms = terms_of(x);
-    for (DTerm &t : terms)
-      t.coef = g_neg(t.coef);
-    return from_terms(std::move(terms));
-  }
-  if (op == UnaryOp::ZeroP) return Value::boolean(false); // it has an infinitesimal part
+  if (op == UnaryOp::Neg) return negate_terms(x);
+  if (op == UnaryOp::ZeroP) return Value::boolean(all_terms_zero(x));
+  if (Value by_sign; (op == UnaryOp::Abs || op == UnaryOp::Magnitude) && abs_by_sign(x, &by_sign))
+    return by_sign;
   uint32_t e = max_differential_tag(x);
   if (long group = group_of(e); group >= 0)
     return apply_on_group(
@@ -326,14 +354,9 @@ Value diff_binary(BinaryOp op, Value a, Value b) {
   case BinaryOp::Div: return diff_mul(a, g_unary(UnaryOp::Invert, b));
   case BinaryOp::Expt: return diff_expt(a, b);
   case BinaryOp::Atan2: return diff_atan2(a, b);
-  case BinaryOp::Equal: {
-    gcvec<DTerm> ta = terms_of(a), tb = terms_of(b);
-    if (ta.size() != tb.size()) return Value::boolean(false);
-    for (size_t i = 0; i < ta.size(); ++i)
-      if (!tags_equal(ta[i], tb[i]) || !g_equal(ta[i].coef, tb[i].coef))
-        return Value::boolean(false);
-    return Value::boolean(true);
-  }
+  case BinaryOp::Equal:
+    // scmutils' diff:binary-comparator: = compares the finite parts.
+    return Value::boolean(g_equal(differential_finite_part(a), differential_finite_part(b)));
   }
   internal_failure(__FILE__, __LINE__, "unknown binary operation");
 }
@@ -614,6 +637,41 @@ void split_by_tag(Value v, uint32_t tag, Value *finite,
   split_differential(v, tag, finite, &tangent);
   keep.push_back(tangent);
   if (!is_exact_zero(tangent)) parts.emplace_back(tag, tangent);
+}
+
+Value differential_finite_part(Value v) {
+  if (!is_differential(v)) return v;
+  Differential *d = as_diff(v);
+  return d->n > 0 && d->terms[0].ntags == 0 ? d->terms[0].coef : Value::fixnum(0);
+}
+
+Value with_finite_part(Value v, Value finite) {
+  if (!is_differential(v)) return v;
+  gcvec<DTerm> terms;
+  terms.push_back(DTerm{nullptr, 0, finite});
+  for (const DTerm &t : terms_of(v))
+    if (t.ntags > 0) terms.push_back(t);
+  return from_terms(std::move(terms));
+}
+
+Value combine_differential_terms(Value a, Value b, const std::function<Value(Value, Value)> &f) {
+  gcvec<DTerm> ta = terms_of(a), tb = terms_of(b), out;
+  Value zero = Value::fixnum(0);
+  size_t i = 0, j = 0;
+  // Both lists are sorted by tag set (from_terms): walk them as a merge.
+  while (i < ta.size() || j < tb.size()) {
+    if (j == tb.size() || (i < ta.size() && tags_less(ta[i], tb[j]))) {
+      out.push_back(DTerm{ta[i].tags, ta[i].ntags, f(ta[i].coef, zero)});
+      ++i;
+    } else if (i == ta.size() || tags_less(tb[j], ta[i])) {
+      out.push_back(DTerm{tb[j].tags, tb[j].ntags, f(zero, tb[j].coef)});
+      ++j;
+    } else {
+      out.push_back(DTerm{ta[i].tags, ta[i].ntags, f(ta[i].coef, tb[j].coef)});
+      ++i, ++j;
+    }
+  }
+  return from_terms(std::move(out));
 }
 
 void register_differential_arith() {

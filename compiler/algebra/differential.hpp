@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -59,6 +60,20 @@ Value times_infinitesimal(Value tangent, uint32_t tag);
 // M^-1 b)) rather than through generic arithmetic.
 void split_by_tag(Value v, uint32_t tag, Value *finite,
                   std::vector<std::pair<uint32_t, Value>> &parts, gcvec<Value> &keep);
+
+// The part of v that carries no infinitesimal: the coefficient of the empty
+// tag set of a differential (0 if it has none), v itself otherwise. What
+// scmutils' comparisons of differentials compare (its finite-part, taken
+// down to the last tag).
+Value differential_finite_part(Value v);
+// v with its finite part replaced by `finite` (v itself if v is not a
+// differential).
+Value with_finite_part(Value v, Value finite);
+// The value whose coefficient of each tag set is f(a's coefficient, b's
+// coefficient), with 0 for a tag set one of them lacks: a choice between two
+// differentials term by term (sicm build's selection of a run-time test's
+// alternatives). a and b are differentials or ordinary values.
+Value combine_differential_terms(Value a, Value b, const std::function<Value(Value, Value)> &f);
 
 // Register the differential arithmetic type with generic arithmetic.
 void register_differential_arith();

@@ -412,6 +412,7 @@ void install_generic_primitives() {
   // Generic arithmetic: every row computes from its arguments alone.
   for (const GenericSpec &p : kGenericPrimitives)
     define_primitive(p.name, p.min_args, p.max_args, Stage::Pure, p.fn);
+  install_differential_comparisons();
   install_structure_primitives();
 }
 

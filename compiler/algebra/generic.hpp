@@ -151,6 +151,9 @@ Value compose_procedures(const Value *fs, size_t n);
 // structure and matrix primitives. Replaces the numbers-only bindings of
 // install_number_primitives, so it must run after it.
 void install_generic_primitives();
+// <, >, <=, >=, positive?, negative?, max and min extended to differentials
+// (algebra/comparison.cpp); called by install_generic_primitives.
+void install_differential_comparisons();
 void register_symbolic_arith();
 void register_function_arith();
 

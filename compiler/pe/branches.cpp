@@ -9,6 +9,8 @@
 #include <functional>
 #include <string>
 
+#include "algebra/differential.hpp"
+#include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
 #include "base/number.hpp"
 #include "eval/core.hpp"
@@ -37,9 +39,33 @@ bool block_calls(const std::vector<RStmt> &block) {
   return false;
 }
 
-namespace {} // namespace
-
 namespace {
+
+bool is_inexact_scalar(Value v) {
+  return v.is(Tag::Flonum) || (is_dynamic_scalar(v) && scalar_type(v) == RType::Real);
+}
+
+// Inside a system derivative (g_build->doubles_only), whose values end as
+// doubles, an exact 0 chosen against an inexact number is 0.: a potential
+// that is 0 on one side ((if (> x 0) (* 1/2 k x x) 0)), and the derivative
+// of such a constant arm, are as inexact as the other arm, since which arm
+// holds is known only at run time. Elsewhere (a value printed at the top
+// level, a monitor) the kinds must agree as the printed form depends on
+// them.
+void match_exact_zero(Value &a, Value &b) {
+  if (g_build->doubles_only == 0) return;
+  if (is_exact_zero(a) && is_inexact_scalar(b)) a = Value::flonum(0.0);
+  if (is_exact_zero(b) && is_inexact_scalar(a)) b = Value::flonum(0.0);
+}
+
+// Two differentials chosen between term by term; a term one of them lacks
+// is an exact 0.
+Value select_differentials(Value test, Value a, Value b) {
+  return combine_differential_terms(a, b,
+                                    [&](Value x, Value y) { return select_values(test, x, y); });
+}
+
+} // namespace
 
 // The value that is `a` when test holds at run time and `b` otherwise.
 Value select_values(Value test, Value a, Value b) {
@@ -52,11 +78,15 @@ Value select_values(Value test, Value a, Value b) {
     // The printed form depends on the kind of number, which must not
     // depend on the test: both truth values, both exact integers (or
     // counts), or both inexact.
+    match_exact_zero(a, b);
     RType ta = scalar_type(a), tb = scalar_type(b);
     if (ta != tb)
       cannot_compile(here(), "the alternatives of a test on a value known only at run time give " +
                                  describe(a) + " and " + describe(b) +
-                                 ", numbers of different kinds (exact and inexact)");
+                                 ", numbers of different kinds (exact and inexact)" +
+                                 (is_exact_zero(a) || is_exact_zero(b)
+                                      ? " (write 0. for a zero that stands for a real number)"
+                                      : ""));
     return let(RCompute::Select, {expr_of(test, "if"), expr_of(a, "if"), expr_of(b, "if")}, ta);
   }
   if (is_structure(a) && is_structure(b) && as_structure(a)->up == as_structure(b)->up &&
@@ -69,6 +99,7 @@ Value select_values(Value test, Value a, Value b) {
   }
   if (is_pair(a) && is_pair(b))
     return cons(select_values(test, car(a), car(b)), select_values(test, cdr(a), cdr(b)));
+  if (is_differential(a) || is_differential(b)) return select_differentials(test, a, b);
   RtList *ra = as_rtlist(a), *rb = as_rtlist(b);
   if (ra && rb && ra->list == rb->list && ra->reversed == rb->reversed)
     return make_rtlist(ra->list, ra->reversed, false, select_values(test, ra->start, rb->start),
@@ -77,6 +108,8 @@ Value select_values(Value test, Value a, Value b) {
                              describe(a) + " and " + describe(b) +
                              ", which cannot be chosen between at run time");
 }
+
+namespace {
 
 // Evaluate one alternative under a run-time test.
 Value speculate(const std::function<Value()> &alternative) {

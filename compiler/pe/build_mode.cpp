@@ -61,6 +61,8 @@
 #include <string>
 #include <unordered_map>
 
+#include "algebra/differential.hpp"
+#include "algebra/generic.hpp"
 #include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
 #include "base/limits.hpp"
@@ -488,9 +490,20 @@ Value compare_chain(Value *a, int n, RCompute c, bool swap, const char *who) {
   return result;
 }
 
+// The arguments with each differential replaced by its finite part, which
+// is what a comparison compares (algebra/comparison.cpp): a test of a
+// differential on the state is a test of the state.
+gcvec<Value> finite_parts(Value *a, int n) {
+  gcvec<Value> out(a, a + n);
+  for (Value &v : out)
+    v = differential_finite_part(v);
+  return out;
+}
+
 template <const char *Name, RCompute C, bool Swap> Value P_compare(Value *a, int n) {
-  if (!any_dynamic(a, n)) return call_original(Name, a, n);
-  return compare_chain(a, n, C, Swap, Name);
+  gcvec<Value> finite = finite_parts(a, n);
+  if (!any_dynamic(finite.data(), n)) return call_original(Name, a, n);
+  return compare_chain(finite.data(), n, C, Swap, Name);
 }
 constexpr char kLess[] = "<";
 constexpr char kGreater[] = ">";
@@ -553,8 +566,11 @@ constexpr char kEqvP[] = "eqv?";
 constexpr char kEqualP[] = "equal?";
 
 template <const char *Name, RCompute C, bool Swap> Value P_sign_test(Value *a, int n) {
-  if (!any_dynamic(a, n)) return call_original(Name, a, n);
-  Value args[2] = {a[0], Value::fixnum(0)};
+  // zero? of a differential is not a test of its finite part (scmutils'
+  // diff:zero? asks whether every coefficient is 0): generic arithmetic's.
+  Value x = C == RCompute::Equal ? a[0] : differential_finite_part(a[0]);
+  if (!any_dynamic(&x, 1)) return call_original(Name, a, n);
+  Value args[2] = {x, Value::fixnum(0)};
   return compare_chain(args, 2, C, Swap, Name);
 }
 constexpr char kZero[] = "zero?";
@@ -569,8 +585,55 @@ constexpr char kFloor[] = "floor";
 constexpr char kRound[] = "round";
 constexpr char kTruncate[] = "truncate";
 
+// max or min of arguments among which are differentials whose finite parts
+// are known only at run time: the argument whose finite part is chosen,
+// selected at run time (algebra/comparison.cpp says what is chosen), with
+// every finite part inexact, since one is.
+Value choose_differential(Value *a, int n, bool max) {
+  gcvec<Value> args(a, a + n);
+  for (Value &v : args) {
+    Value f = differential_finite_part(v);
+    if (is_number(f) && !f.is(Tag::Flonum)) v = with_finite_part(v, num_exact_to_inexact(f));
+    if (is_number(v) && !v.is(Tag::Flonum)) v = num_exact_to_inexact(v);
+  }
+  Value best = args[0];
+  for (int i = 1; i < n; ++i) {
+    // max: a later argument replaces the best one if the best is less.
+    Value pair[2] = {differential_finite_part(max ? best : args[i]),
+                     differential_finite_part(max ? args[i] : best)};
+    Value test = compare_chain(pair, 2, RCompute::Less, false, "<");
+    if (!is_dynamic_boolean(test))
+      best = test.truthy() ? args[i] : best;
+    else
+      best = select_values(test, args[i], best);
+  }
+  return best;
+}
+
+// abs or magnitude of a differential whose finite part is known only at
+// run time: x or -x, chosen at run time by the sign of that part, as
+// algebra/differential.cpp chooses it for a number (scmutils' diff:abs), so
+// its coefficients keep their kinds where a value may be printed. Where the
+// part is 0 this gives x (sicm run's interpreter stops: no derivative
+// there). A system derivative is traced as sicm run traces its kernels, with
+// the slope x/|x| of generic arithmetic (g_build->doubles_only), so that
+// both compile the same kernel.
+template <const char *Name> Value P_abs(Value *a, int n) {
+  Value f = differential_finite_part(a[0]);
+  if (!is_differential(a[0]) || !is_dynamic_scalar(f) || g_build->doubles_only > 0)
+    return call_original(Name, a, n);
+  Value pair[2] = {f, Value::fixnum(0)};
+  Value negative = compare_chain(pair, 2, RCompute::Less, false, "<");
+  return select_values(negative, g_neg(a[0]), a[0]);
+}
+constexpr char kAbs[] = "abs";
+constexpr char kMagnitude[] = "magnitude";
+
 template <const char *Name, RCompute C> Value P_fold(Value *a, int n) {
-  if (!any_dynamic(a, n)) return call_original(Name, a, n);
+  gcvec<Value> finite = finite_parts(a, n);
+  if (!any_dynamic(finite.data(), n)) return call_original(Name, a, n);
+  for (int i = 0; i < n; ++i)
+    if (is_differential(a[i])) return choose_differential(a, n, C == RCompute::Max);
   Value acc = a[0];
   for (int i = 1; i < n; ++i)
     acc = let(C, {expr_of(acc, Name), expr_of(a[i], Name)}, RType::Real);
@@ -707,7 +770,7 @@ const PrimFn p_zero_p = P_sign_test<kZero, RCompute::Equal, false>,
 const PrimFn p_floor = P_unary<kFloor, RCompute::Floor>, p_round = P_unary<kRound, RCompute::Round>,
              p_truncate = P_unary<kTruncate, RCompute::Truncate>,
              p_max = P_fold<kMax, RCompute::Max>, p_min = P_fold<kMin, RCompute::Min>,
-             p_not = P_not;
+             p_abs = P_abs<kAbs>, p_magnitude = P_abs<kMagnitude>, p_not = P_not;
 const PrimFn p_eq_p = P_same<kEqP, false>, p_eqv_p = P_same<kEqvP, false>,
              p_equal_p = P_same<kEqualP, true>;
 const PrimFn p_random = P_random, p_real_time = P_real_time, p_parameter = P_parameter,

@@ -587,6 +587,19 @@ struct NotShapedLikeState {};
 
 } // namespace
 
+namespace {
+
+// While it lives, the procedure being traced is one whose values end as
+// doubles (select_values in pe/branches.cpp).
+struct DoublesOnly {
+  DoublesOnly() { ++g_build->doubles_only; }
+  ~DoublesOnly() { --g_build->doubles_only; }
+  DoublesOnly(const DoublesOnly &) = delete;
+  DoublesOnly &operator=(const DoublesOnly &) = delete;
+};
+
+} // namespace
+
 // A system derivative traced into a new function of the state's leaves
 // whose outputs are the derivative's leaves, in the form the interpreter's
 // compiled derivatives take (kernel_outputs: evolve in `sicm run` compiles
@@ -601,6 +614,7 @@ struct NotShapedLikeState {};
 int trace_system_function(Value sysder, Value state, const char *who) {
   if (!is_state_shape(state)) wrong_type(state, 1, who);
   SrcLoc call = here(); // the integrator's call: the trace moves into sysder
+  DoublesOnly doubles;
   try {
     KernelTraceScope parameters;
     FunctionScope scope(procedure_name(sysder));
@@ -687,11 +701,16 @@ void trace_singular_factors(Value state, RStmt &s) {
 
 // For the implicit methods, the Jacobian (D sysder) traced as a function of
 // the state too (its leaves: d f_i / d y_j at j * dim + i), as sicm run
-// compiles it; left to finite differences when it cannot be traced.
+// compiles it; left to finite differences when it cannot be traced, and,
+// as sicm run leaves it (builtins/numerics.cpp), when the derivative is not
+// a kernel: one that tests the state (whose Jacobian D now traces through
+// the test) integrates with the same steps in both.
 void trace_jacobian(Value sysder, Value state, RStmt &s) {
   if (s.method != "sicm_ode_step_msbdf" && s.method != "sicm_ode_step_cvode_bdf") return;
+  if (s.callee < 0 || !g_build->program.functions[s.callee].kernel) return;
   Symbol *d = intern("D").symbol();
   if (!d->bound) return;
+  DoublesOnly doubles;
   KernelTraceScope parameters;
   try {
     FunctionScope scope("jacobian");

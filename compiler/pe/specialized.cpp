@@ -33,6 +33,8 @@ const std::vector<Specialization> &specializations() {
       {"truncate", 1, 1, p_truncate},
       {"max", 1, kVariadic, p_max},
       {"min", 1, kVariadic, p_min},
+      {"abs", 1, 1, p_abs},
+      {"magnitude", 1, 1, p_magnitude},
       {"not", 1, 1, p_not},
       {"eq?", 2, 2, p_eq_p},
       {"eqv?", 2, 2, p_eqv_p},

@@ -38,7 +38,7 @@ const std::vector<const char *> &effects_done_while_compiling();
 extern const PrimFn p_display, p_write, p_write_line, p_pp, p_print_expression, p_pe;
 extern const PrimFn p_less, p_greater, p_less_eq, p_greater_eq, p_num_equal;
 extern const PrimFn p_zero_p, p_positive_p, p_negative_p;
-extern const PrimFn p_floor, p_round, p_truncate, p_max, p_min, p_not;
+extern const PrimFn p_floor, p_round, p_truncate, p_max, p_min, p_abs, p_magnitude, p_not;
 extern const PrimFn p_eq_p, p_eqv_p, p_equal_p;
 extern const PrimFn p_random, p_real_time, p_parameter, p_runtime;
 extern const PrimFn p_number_p, p_real_p, p_inexact_p, p_exact_p, p_integer_p, p_exact_integer_p,

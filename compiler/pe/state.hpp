@@ -94,6 +94,10 @@ struct BuildState {
   std::vector<uint32_t> undo_serials;    // g_frame_serial when each log began
   long branch_evaluations = 0;           // alternatives evaluated under tests on run-time values
   std::vector<size_t> capture_depths;    // open.size() when each with-output-to-string began
+  // Traces of procedures whose values end as doubles (a system derivative
+  // and its Jacobian), nested: there an exact 0 chosen against an inexact
+  // number is 0. (select_values).
+  int doubles_only = 0;
 
   // ---- pe/lists.cpp
   std::vector<ListCell> list_cells; // the variables that hold run-time lists
@@ -226,6 +230,9 @@ void log_assignment(const Assignment &a);
 // Does the block call a function or add to a list (after which cells and
 // lists are read again)?
 bool block_calls(const std::vector<RStmt> &block);
+// The value that is `a` when the run-time truth value `test` holds and `b`
+// otherwise (numbers, structures, pairs, run-time lists, differentials).
+Value select_values(Value test, Value a, Value b);
 
 // The evaluator's hooks (DynamicBranchHooks in eval/procedure.hpp).
 bool hook_dynamic_test(Value test);
