@@ -121,7 +121,7 @@ private:
   Value renamed(Value datum) const {
     if (is_symbol(datum)) {
       std::string name = name_of_(datum.symbol());
-      return name.empty() ? datum : make_uninterned_symbol(name);
+      return name.empty() ? datum : intern(name); // the user's terms, not a generated name
     }
     if (!is_pair(datum)) return datum;
     return cons(renamed(car(datum)), renamed(cdr(datum)));

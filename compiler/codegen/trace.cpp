@@ -11,9 +11,12 @@
 #include "codegen/trace.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <string>
 #include <unordered_map>
 #include <unordered_set>
+#include <vector>
 
 #include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
@@ -149,6 +152,42 @@ Value apply_traced(Value proc, gcvec<Value> args) {
   return apply_procedure(proc, args.data(), static_cast<int>(args.size()));
 }
 
+// An error's text with the trace's names for the arguments' leaves (x0,
+// x1, ..., which the user never wrote) replaced by where each leaf is:
+// <the first argument>, <(ref (the second argument) 1 0)>.
+static std::string in_users_terms(std::string text, const gcvec<Value> &samples, const Trace &t) {
+  std::vector<std::pair<std::string, std::string>> names; // trace name -> description
+  size_t k = 0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    std::string arg = std::string("the ") + ordinal(i) + " argument";
+    std::vector<std::string> paths = state_leaf_paths(samples[i], "(" + arg + ")");
+    for (const std::string &path : paths)
+      if (k < t.inputs.size())
+        names.emplace_back(t.inputs[k++]->name, paths.size() == 1 && is_number(samples[i])
+                                                    ? "<" + arg + ">"
+                                                    : "<" + path + ">");
+  }
+  // Longest names first: x10 before x1.
+  std::sort(names.begin(), names.end(),
+            [](const auto &a, const auto &b) { return a.first.size() > b.first.size(); });
+  auto word_char = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  for (const auto &[name, description] : names) {
+    for (const std::string &form : {"\u00ab" + name + "\u00bb", name}) {
+      for (size_t at = text.find(form); at != std::string::npos; at = text.find(form, at)) {
+        bool whole = (at == 0 || !word_char(text[at - 1])) &&
+                     (at + form.size() >= text.size() || !word_char(text[at + form.size()]));
+        if (!whole) {
+          at += form.size();
+          continue;
+        }
+        text.replace(at, form.size(), description);
+        at += description.size();
+      }
+    }
+  }
+  return text;
+}
+
 bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_not) {
   if (!is_procedure(proc)) {
     *why_not = "the object " + brief(proc) + " is not a procedure";
@@ -189,7 +228,8 @@ bool trace_procedure(Value proc, Value sample_args, Trace *t, std::string *why_n
     }
     return collect_outputs(result, t, why_not);
   } catch (const Error &e) {
-    *why_not = std::string("applying it to symbolic arguments failed: ") + e.what();
+    *why_not = std::string("applying it to symbolic arguments failed: ") +
+               in_users_terms(e.what(), samples, *t);
     return false;
   }
 }
