@@ -166,6 +166,7 @@ Value structure_binary_ops(BinaryOp op, Value a, Value b) {
   case BinaryOp::Add:
   case BinaryOp::Sub:
     if (sa && sb) return componentwise(op, a, b);
+    if (is_procedure(a) || is_procedure(b)) return function_combination(op, a, b);
     arith_wrong_type(op, sa ? a : b, sa ? 1 : 2);
   case BinaryOp::Mul: return structure_mul(a, b);
   case BinaryOp::Div:
@@ -296,6 +297,7 @@ Value matrix_binary_ops(BinaryOp op, Value a, Value b) {
   case BinaryOp::Sub:
     if (ma && mb) return matrix_elementwise(op, a, b);
     if (is_structure(a) || is_structure(b)) shape_mismatch(op_scheme_name(op), a, b);
+    if (is_procedure(a) || is_procedure(b)) return function_combination(op, a, b);
     arith_wrong_type(op, ma ? a : b, ma ? 1 : 2);
   case BinaryOp::Mul: return matrix_mul(a, b);
   case BinaryOp::Div: return matrix_div(a, b);
