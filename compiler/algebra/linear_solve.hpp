@@ -6,7 +6,8 @@
 // mass matrix had tens of millions of terms), and its expanded determinant
 // cancels in floating point. So while a procedure is traced into a kernel
 // (a KernelTracing object lives on this thread), dividing by a square
-// structure or matrix whose entries are run-time values -- the mass matrix
+// structure (of any nesting, flattened by structure_linear_map.cpp) or
+// matrix whose entries are run-time values -- the mass matrix
 // of Lagrangian->state-derivative, the velocity solve of a Legendre
 // transform, (/ b M) in user code -- makes one node per component of the
 // solution:
