@@ -19,13 +19,13 @@
 // that M maps a structure x of the dual of the outer shape to (* M x), of
 // shape I. Its inverse maps structures of shape I back: an outer structure
 // of the dual of I whose parts have x's shape.
+#include <algorithm>
 #include <optional>
 #include <string>
 
 #include "algebra/generic.hpp"
 #include "algebra/linear_solve.hpp"
 #include "algebra/structure.hpp"
-#include "algebra/structure_internal.hpp"
 #include "base/error.hpp"
 #include "base/number.hpp"
 #include "base/primitive.hpp"
@@ -70,7 +70,7 @@ std::optional<Value> quotient_shape(Value b, Value m) {
 // where each leaf goes costs no symbolic arithmetic: each leaf of
 // (* m e_j) is one leaf of m or nothing, since a product of structures is
 // bilinear in their leaves.
-std::optional<gcvec<Value>> map_matrix(Value m, Value x_shape, Value y_shape) {
+std::optional<gcvec<Value>> matrix_of_map(Value m, Value x_shape, Value y_shape) {
   size_t n = structure_dimension(x_shape);
   if (!is_structure(x_shape) || !is_structure(y_shape) || structure_dimension(y_shape) != n)
     return std::nullopt;
@@ -164,7 +164,7 @@ std::optional<SquareMap> square_map(Value m) {
   std::optional<Value> x_shape = argument_shape(m);
   if (!x_shape) return std::nullopt;
   Value y_shape = g_mul(zeros_like(m, false), *x_shape);
-  std::optional<gcvec<Value>> a = map_matrix(m, *x_shape, y_shape);
+  std::optional<gcvec<Value>> a = matrix_of_map(m, *x_shape, y_shape);
   if (!a) return std::nullopt;
   return SquareMap{*x_shape, y_shape, structure_dimension(*x_shape), std::move(*a)};
 }
@@ -189,7 +189,7 @@ Value divide_by_structure(Value b, Value m) {
   if (!is_structure(b)) return g_mul(b, structure_inverse(m, "/"));
   std::optional<Value> x_shape = quotient_shape(b, m);
   std::optional<gcvec<Value>> a;
-  if (x_shape) a = map_matrix(m, *x_shape, b);
+  if (x_shape) a = matrix_of_map(m, *x_shape, b);
   if (!a)
     runtime_error(current_call_loc(),
                   "/: cannot divide " + write_string(b) + " by " + write_string(m) +
