@@ -40,9 +40,11 @@ const OpaqueKind kNativeKind = {"compound-procedure", write_native, apply_native
 
 // The value of an operand at the arguments: procedures are called (on a copy
 // of the arguments, so that one callee cannot disturb what the next sees),
-// other values are constants.
+// and so are structures and matrices, entry by entry (scmutils'
+// coerce-to-function applies whatever is not a number); other values are
+// constants.
 Value operand_value(Value f, const Value *args, int nargs) {
-  if (!is_procedure(f)) return f;
+  if (!is_procedure(f) && !f.is(Tag::Structure) && !f.is(Tag::Matrix)) return f;
   constexpr int kSmall = 8;
   if (nargs <= kSmall) {
     Value copy[kSmall];
@@ -128,6 +130,10 @@ void native_arity_error(NativeProc *self, int given, int min, int max) {
                     (min == max ? "exactly " + plural(min)
                                 : "between " + std::to_string(min) + " and " + plural(max)) +
                     ".");
+}
+
+Value function_combination(BinaryOp op, Value a, Value b) {
+  return make_native_procedure(call_binary, static_cast<int>(op), a, b);
 }
 
 Value compose_procedures(const Value *fs, size_t n) {

@@ -142,6 +142,11 @@ Value make_native_procedure(NativeFn fn, int op, Value a, Value b, const Value *
 [[noreturn]] void native_arity_error(NativeProc *self, int given, int required);
 // ... "it requires between 4 and 6 arguments." (exactly, when min == max).
 [[noreturn]] void native_arity_error(NativeProc *self, int given, int min, int max);
+// (op a b) as a function, x... |-> (op (a x...) (b x...)): what a sum or
+// difference of a structure or matrix and a procedure is, the structure
+// applied entry by entry (arithmetic on structures of functions is
+// arithmetic on functions, as in scmutils).
+Value function_combination(BinaryOp op, Value a, Value b);
 // (compose f g ...): the procedure x... |-> (f (g ... x...)).
 Value compose_procedures(const Value *fs, size_t n);
 

@@ -80,13 +80,6 @@ template <typename Entry> bool wants_interpreted_solve(size_t n, Entry entry) {
   return run_time;
 }
 
-bool all_numbers_or_run_time(const Structure *s) {
-  for (size_t i = 0; i < s->len; ++i)
-    if (!is_number(s->items[i]) && !(run_time_value_test() && run_time_value_test()(s->items[i])))
-      return false;
-  return true;
-}
-
 // The solution of M x = b as a structure of solve nodes with the given head
 // (orientation up or down), M given by entry(i, j).
 template <typename Entry>
@@ -178,33 +171,52 @@ bool is_solvable(Value v) {
   return is_scalar(v) || is_differential(v);
 }
 
-// (/ a C) through differentials in a kernel (see solve_values), when C is
+// C x = b in a kernel through differentials (see solve_values), when C is
 // larger than kMaxSymbolicSolve: the symbolic inverse of a matrix of
 // differentials grows as fast as that of expressions.
 template <typename Entry>
-std::optional<Value> differential_solve(size_t n, Entry entry, const Structure *a, bool result_up) {
+std::optional<gcvec<Value>> differential_solve(size_t n, Entry entry, const Value *b) {
   if (g_kernel_tracing == 0 || n <= kMaxSymbolicSolve) return std::nullopt;
   bool differentials = false;
-  gcvec<Value> c(n * n), b(a->items, a->items + n);
+  gcvec<Value> c(n * n), rhs(b, b + n);
   for (size_t i = 0; i < n; ++i)
     for (size_t j = 0; j < n; ++j) {
       c[i * n + j] = entry(i, j);
       if (!is_solvable(c[i * n + j])) return std::nullopt;
       differentials = differentials || is_differential(c[i * n + j]);
     }
-  for (Value v : b) {
+  for (Value v : rhs) {
     if (!is_solvable(v)) return std::nullopt;
     differentials = differentials || is_differential(v);
   }
   if (!differentials) return std::nullopt;
-  gcvec<Value> x = solve_values(n, c, b);
-  return make_structure_from(result_up, x.data(), n);
+  return solve_values(n, c, rhs);
 }
 
-bool all_scalars(const Structure *s) {
-  for (size_t i = 0; i < s->len; ++i)
-    if (!is_scalar(s->items[i])) return false;
-  return true;
+bool all_scalars(const Value *items, size_t n) {
+  return std::all_of(items, items + n, is_scalar);
+}
+
+bool all_numbers_or_run_time(const Value *items, size_t n) {
+  RunTimeValueTest is_run_time = run_time_value_test();
+  return std::all_of(items, items + n,
+                     [&](Value v) { return is_number(v) || (is_run_time && is_run_time(v)); });
+}
+
+// M x = b, M given by entry(i, j), as solve nodes (see traced_solve).
+template <typename Entry>
+std::optional<gcvec<Value>> traced_solve_of(size_t n, Entry entry, const Value *b) {
+  if (g_kernel_tracing == 0 && !run_time_value_test()) return std::nullopt;
+  if (std::optional<gcvec<Value>> x = differential_solve(n, entry, b)) return x;
+  if (!all_scalars(b, n)) return std::nullopt;
+  Value x;
+  if (wants_interpreted_solve(n, entry) && all_numbers_or_run_time(b, n))
+    x = solve_structure(n, entry, b, true, interpreted_solve_head());
+  else if (wants_solve(n, entry))
+    x = solve_structure(n, entry, b, true);
+  else
+    return std::nullopt;
+  return gcvec<Value>(as_structure(x)->items, as_structure(x)->items + n);
 }
 
 } // namespace
@@ -261,33 +273,9 @@ ExprId solve_rhs_entry(ExprId id, size_t i) {
   return expr_arg(id, 1 + n * n + i);
 }
 
-// (/ a s) is a times the inverse of s (structure.cpp). With C the matrix
-// whose columns are s's components (C(i, j) = s[j][i]), the inverse is the
-// structure of C^-1 with the dual orientations, and the product contracts
-// to C^-1 a exactly when a's orientation is that of s's components; the
-// result then has the dual of s's outer orientation. Other combinations
-// do not contract and are left to the general path.
-std::optional<Value> traced_structure_solve(Value a, Value s) {
-  if ((g_kernel_tracing == 0 && !run_time_value_test()) || !is_structure(a) || !is_structure(s))
-    return std::nullopt;
-  Structure *st = as_structure(s), *av = as_structure(a);
-  size_t n = st->len;
-  if (n == 0 || av->len != n) return std::nullopt;
-  for (size_t j = 0; j < n; ++j) {
-    Value c = st->items[j];
-    if (!is_structure(c) || as_structure(c)->len != n ||
-        as_structure(c)->up != as_structure(st->items[0])->up)
-      return std::nullopt;
-  }
-  bool inner_up = as_structure(st->items[0])->up;
-  if (av->up != inner_up) return std::nullopt;
-  auto entry = [&](size_t i, size_t j) { return as_structure(st->items[j])->items[i]; };
-  if (std::optional<Value> x = differential_solve(n, entry, av, !st->up)) return x;
-  if (!all_scalars(av)) return std::nullopt;
-  if (wants_interpreted_solve(n, entry) && all_numbers_or_run_time(av))
-    return solve_structure(n, entry, av->items, !st->up, interpreted_solve_head());
-  if (!wants_solve(n, entry)) return std::nullopt;
-  return solve_structure(n, entry, av->items, !st->up);
+std::optional<gcvec<Value>> traced_solve(size_t n, const gcvec<Value> &m, const Value *b) {
+  return traced_solve_of(
+      n, [&](size_t i, size_t j) { return m[i * n + j]; }, b);
 }
 
 // (/ a m) with a an up is m^-1 a, an up (matrix_div and matrix_times_up).
@@ -298,13 +286,10 @@ std::optional<Value> traced_matrix_solve(Value a, Value m) {
   Structure *av = as_structure(a);
   size_t n = mm->rows;
   if (mm->cols != n || !av->up || av->len != n) return std::nullopt;
-  auto entry = [&](size_t i, size_t j) { return matrix_at(mm, i, j); };
-  if (std::optional<Value> x = differential_solve(n, entry, av, true)) return x;
-  if (!all_scalars(av)) return std::nullopt;
-  if (wants_interpreted_solve(n, entry) && all_numbers_or_run_time(av))
-    return solve_structure(n, entry, av->items, true, interpreted_solve_head());
-  if (!wants_solve(n, entry)) return std::nullopt;
-  return solve_structure(n, entry, av->items, true);
+  std::optional<gcvec<Value>> x = traced_solve_of(
+      n, [&](size_t i, size_t j) { return matrix_at(mm, i, j); }, av->items);
+  if (!x) return std::nullopt;
+  return make_structure_from(true, x->data(), n);
 }
 
 } // namespace sicm

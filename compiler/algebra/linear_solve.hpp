@@ -6,7 +6,8 @@
 // mass matrix had tens of millions of terms), and its expanded determinant
 // cancels in floating point. So while a procedure is traced into a kernel
 // (a KernelTracing object lives on this thread), dividing by a square
-// structure or matrix whose entries are run-time values -- the mass matrix
+// structure (of any nesting, flattened by structure_linear_map.cpp) or
+// matrix whose entries are run-time values -- the mass matrix
 // of Lagrangian->state-derivative, the velocity solve of a Legendre
 // transform, (/ b M) in user code -- makes one node per component of the
 // solution:
@@ -72,12 +73,14 @@ size_t solve_component(ExprId id);
 ExprId solve_matrix_entry(ExprId id, size_t i, size_t j);
 ExprId solve_rhs_entry(ExprId id, size_t i);
 
-// (/ a s) for a square two-tensor s and a structure a of scalars, as solve
-// nodes, when kernels are being traced and s is a matrix the kernel should
-// factor at run time; nullopt when the caller should invert s as usual.
-std::optional<Value> traced_structure_solve(Value a, Value s);
+// M x = b for the n x n matrix M (row-major: M(i, j) = m[i n + j]) and the
+// n values b, as solve nodes, when kernels are being traced (or sicm build
+// computes with run-time values) and M is a matrix the kernel should factor
+// at run time; nullopt when the caller should invert M as usual. Structures
+// of any nesting divide through this, flattened (structure_linear_map.cpp).
+std::optional<gcvec<Value>> traced_solve(size_t n, const gcvec<Value> &m, const Value *b);
 
-// The same for (/ a m) with m a square matrix and a an up or down of scalars.
+// The same for (/ a m) with m a square matrix and a an up of scalars.
 std::optional<Value> traced_matrix_solve(Value a, Value m);
 
 } // namespace sicm

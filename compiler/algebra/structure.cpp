@@ -160,21 +160,13 @@ Value integer_power(Value x, Value exponent, BinaryOp op) {
   return acc;
 }
 
-// (/ a s): a times the inverse of s; an up is solved for on the right of the
-// inverse, as the book writes a column vector.
-Value divide_by_structure(Value a, Value s) {
-  if (std::optional<Value> solved = traced_structure_solve(a, s)) return *solved;
-  Value inverse = structure_inverse(s, "/");
-  if (is_structure(a) && as_structure(a)->up) return g_mul(inverse, a);
-  return g_mul(a, inverse);
-}
-
 Value structure_binary_ops(BinaryOp op, Value a, Value b) {
   bool sa = is_structure(a), sb = is_structure(b);
   switch (op) {
   case BinaryOp::Add:
   case BinaryOp::Sub:
     if (sa && sb) return componentwise(op, a, b);
+    if (is_procedure(a) || is_procedure(b)) return function_combination(op, a, b);
     arith_wrong_type(op, sa ? a : b, sa ? 1 : 2);
   case BinaryOp::Mul: return structure_mul(a, b);
   case BinaryOp::Div:
@@ -305,6 +297,7 @@ Value matrix_binary_ops(BinaryOp op, Value a, Value b) {
   case BinaryOp::Sub:
     if (ma && mb) return matrix_elementwise(op, a, b);
     if (is_structure(a) || is_structure(b)) shape_mismatch(op_scheme_name(op), a, b);
+    if (is_procedure(a) || is_procedure(b)) return function_combination(op, a, b);
     arith_wrong_type(op, ma ? a : b, ma ? 1 : 2);
   case BinaryOp::Mul: return matrix_mul(a, b);
   case BinaryOp::Div: return matrix_div(a, b);
@@ -510,35 +503,6 @@ Value dense_determinant(Dense &d) {
   return bareiss_determinant(d);
 }
 
-// A structure of n > 0 structures of one orientation and one length m: a
-// linear map, whose matrix (m x n) has the components as its columns.
-bool is_two_tensor(Value v) {
-  if (!is_structure(v) || as_structure(v)->len == 0) return false;
-  Structure *s = as_structure(v);
-  if (!is_structure(s->items[0])) return false;
-  Structure *first = as_structure(s->items[0]);
-  for (size_t i = 0; i < s->len; ++i) {
-    if (!is_structure(s->items[i])) return false;
-    Structure *c = as_structure(s->items[i]);
-    if (c->up != first->up || c->len != first->len) return false;
-  }
-  return true;
-}
-
-Dense two_tensor_columns(Value v) {
-  Structure *s = as_structure(v);
-  size_t m = as_structure(s->items[0])->len;
-  Dense d(m, s->len);
-  for (size_t j = 0; j < s->len; ++j)
-    for (size_t i = 0; i < m; ++i)
-      d.at(i, j) = as_structure(s->items[j])->items[i];
-  return d;
-}
-
-Value matrix_of(Dense &d) {
-  return generate_matrix(d.rows, d.cols, [&](size_t i, size_t j) { return d.at(i, j); });
-}
-
 } // namespace
 
 Value matrix_inverse(Value mv, const char *who) {
@@ -560,35 +524,13 @@ Value matrix_inverse(Value mv, const char *who) {
   return generate_matrix(n, n, [&](size_t i, size_t j) { return d.at(i, n + j); });
 }
 
-// The inverse map of a square two-tensor S: it takes what S produces (vectors
-// of S's inner orientation) back to what S takes (the dual of S's outer
-// orientation), so its orientations are the duals of S's, exchanged.
-Value structure_inverse(Value s, const char *who) {
-  if (!is_two_tensor(s) || as_structure(as_structure(s)->items[0])->len != as_structure(s)->len)
-    runtime_error(current_call_loc(), std::string(who) + ": cannot invert " + write_string(s) +
-                                          ": only a square structure of structures (such as a "
-                                          "down of downs) is a linear map that can be");
-  Dense columns = two_tensor_columns(s);
-  Matrix *inverse = as_matrix(matrix_inverse(matrix_of(columns), who));
-  Structure *st = as_structure(s);
-  bool outer_up = st->up, inner_up = as_structure(st->items[0])->up;
-  size_t n = st->len;
-  return generate_structure(!inner_up, n, [&](size_t k) {
-    return generate_structure(!outer_up, n, [&](size_t i) { return matrix_at(inverse, i, k); });
-  });
-}
-
 Value determinant(Value x) {
   if (is_matrix(x)) {
     if (as_matrix(x)->rows != as_matrix(x)->cols) wrong_type(x, 1, "determinant");
     Dense d = dense_of(x);
     return dense_determinant(d);
   }
-  if (is_two_tensor(x)) {
-    Dense d = two_tensor_columns(x);
-    if (d.rows != d.cols) wrong_type(x, 1, "determinant");
-    return dense_determinant(d);
-  }
+  if (is_structure(x)) return structure_determinant(x);
   if (is_number(x) || is_symbolic(x)) return x;
   wrong_type(x, 1, "determinant");
 }

@@ -57,13 +57,23 @@ Value shape_from_leaves(Value shape, bool dual, const Value *leaves);
 // Contraction when a and b are structures compatible for it, else the first
 // factor times each component of the second.
 Value structure_mul(Value a, Value b);
-// The linear-algebra inverse of a square matrix, or of a structure of n
-// structures of length n viewed as a linear map (its components are the
-// columns). `who` names the caller in the "singular" error.
+// The linear-algebra inverse of a square matrix. `who` names the caller in
+// the "singular" error.
 Value matrix_inverse(Value m, const char *who);
-Value structure_inverse(Value s, const char *who);
-// Determinant of a square matrix or of a square structure of structures.
+// Determinant of a square matrix, or of a structure that is a square linear map.
 Value determinant(Value m);
+
+// ---- structures as linear maps (structure_linear_map.cpp) ----
+// A structure of any nesting is a linear map x |-> (* s x); these flatten
+// it to its matrix, as scmutils does. (/ b s) for a structure s: the x with
+// (* s x) = b (for a scalar b, b times the inverse of s).
+Value divide_by_structure(Value b, Value s);
+// The inverse map of a square linear map s (a down of downs, the mass
+// matrix of nested coordinates, ...); `who` names the caller in errors.
+Value structure_inverse(Value s, const char *who);
+Value structure_determinant(Value s);
+// The k-th basis structure of shape's shape: leaf k is 1, the others 0.
+Value basis_element(Value shape, size_t k);
 
 // Register the structure and matrix arithmetic type with generic arithmetic,
 // and the structure and matrix primitives (up, down, ref, matrix-by-rows, ...),

@@ -38,13 +38,6 @@ Value matrix_to_datum(Value v) {
   return cons(intern("matrix-by-rows"), rows);
 }
 
-// The structure of `shape` with a 1 at leaf k and exact zeros elsewhere.
-Value basis_element(Value shape, size_t k) {
-  gcvec<Value> leaves(structure_dimension(shape), Value::fixnum(0));
-  leaves[k] = Value::fixnum(1);
-  return shape_from_leaves(shape, false, leaves.data());
-}
-
 } // namespace
 
 // ---- primitives: structures -------------------------------------------------------------------

@@ -142,6 +142,19 @@ Value apply_structure(Value s, Value *args, int nargs) {
   return Value::object(Tag::Structure, out);
 }
 
+// A matrix of procedures applies entry by entry as well (scmutils'
+// matrices are applicable as its structures are): ((Euler->M angles) t)
+// for angles an up of functions of time.
+Value apply_matrix(Value m, Value *args, int nargs) {
+  Matrix *mt = m.as<Matrix>();
+  size_t n = mt->rows * mt->cols;
+  Matrix *out = gc_new<Matrix>(Matrix{mt->rows, mt->cols, nullptr});
+  out->items = static_cast<Value *>(GC_MALLOC(sizeof(Value) * (n ? n : 1)));
+  for (size_t k = 0; k < n; ++k)
+    out->items[k] = apply_procedure(mt->items[k], args, nargs);
+  return Value::object(Tag::Matrix, out);
+}
+
 } // namespace
 
 Frame *make_frame(Frame *parent, uint32_t size) {
@@ -200,6 +213,7 @@ Value apply_procedure(Value proc, Value *args, int nargs) {
       return o->kind->apply(o->obj, args, nargs);
     }
     if (proc.is(Tag::Structure)) return apply_structure(proc, args, nargs);
+    if (proc.is(Tag::Matrix)) return apply_matrix(proc, args, nargs);
     not_applicable(proc, g_call_loc);
   }
   Closure *c = proc.as<Closure>();
@@ -243,6 +257,10 @@ Value *evaluate_operands(Node *n, Frame *env, Value (&small)[kSmallArgs], gcvec<
   if (f.is(Tag::Structure)) {
     g_call_loc = n->loc;
     return apply_structure(f, args, static_cast<int>(nargs));
+  }
+  if (f.is(Tag::Matrix)) {
+    g_call_loc = n->loc;
+    return apply_matrix(f, args, static_cast<int>(nargs));
   }
   if (!f.is(Tag::Primitive)) throw_to_continuation(f, args, static_cast<int>(nargs));
   return call_primitive(f, args, nargs, n->loc);
@@ -420,7 +438,7 @@ Value eval(Node *n, Frame *env) {
         continue;
       }
       if (!f.is(Tag::Primitive) && !is_continuation(f) && !is_applicable_opaque(f) &&
-          !f.is(Tag::Structure))
+          !f.is(Tag::Structure) && !f.is(Tag::Matrix))
         not_applicable(f, n->loc);
       if (f.p == g_apply_primitive) {
         TailApply t = eval_apply(f, n, env);

@@ -90,6 +90,28 @@ TEST(Structure, InverseOfDownOfDownsIsUpOfUps) {
   EXPECT_EQ(show(sicm::g_mul(inverse, sicm::g_mul(s, v))), "(up 2 3)");
 }
 
+TEST(Structure, NestedMassMatrixDividesAsItsFlattenedMatrix) {
+  // The Hessian of 1/2 (v1.v1) + 2 (v2.v2) + v1.v2 in v = (up (up a b) (up c d)):
+  // flattened, [[1 0 1 0] [0 1 0 1] [1 0 4 0] [0 1 0 4]].
+  auto block = [](int64_t a, int64_t c) {
+    return down({down({down({fx(a), fx(0)}), down({fx(c), fx(0)})}),
+                 down({down({fx(0), fx(a)}), down({fx(0), fx(c)})})});
+  };
+  Value m = down({block(1, 1), block(1, 4)});
+  Value v = up({up({fx(1), fx(2)}), up({fx(3), fx(4)})});
+  Value p = sicm::g_mul(m, v);
+  EXPECT_EQ(show(p), "(down (down 4 6) (down 13 18))");
+  EXPECT_EQ(show(sicm::divide_by_structure(p, m)), "(up (up 1 2) (up 3 4))");
+  Value inverse = sicm::structure_inverse(m, "test");
+  EXPECT_EQ(show(sicm::g_mul(inverse, p)), "(up (up 1 2) (up 3 4))");
+  EXPECT_EQ(show(sicm::determinant(m)), "9");
+}
+
+TEST(Structure, DivisionWithoutASquareMapIsAnError) {
+  EXPECT_THROW(sicm::divide_by_structure(up({fx(1), fx(2)}), down({fx(3), fx(4)})), sicm::Error);
+  EXPECT_THROW(sicm::structure_inverse(down({down({fx(1), fx(2), fx(3)})}), "test"), sicm::Error);
+}
+
 TEST(Matrix, ProductInverseDeterminant) {
   Value a = matrix(2, 2, {1, 2, 3, 4});
   EXPECT_EQ(show(sicm::g_mul(a, a)), "(matrix-by-rows (list 7 10) (list 15 22))");
