@@ -3,6 +3,8 @@
 // evaluation, no C compiler and its linker's messages).
 #include <gtest/gtest.h>
 
+#include "sicm_command.hpp"
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -13,10 +15,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string sicm_path() {
-  const char *e = std::getenv("SICM_BINARY");
-  return e && *e ? e : "build/sicm";
-}
+using sicm_test::command_output;
+using sicm_test::sicm_path;
 
 // stdout and stderr of `sicm build PROGRAM -o output`, then "status=N".
 std::string build_to(const std::string &output, const std::string &program_text = "(display 1)\n") {
@@ -24,13 +24,7 @@ std::string build_to(const std::string &output, const std::string &program_text 
   std::ofstream(program) << program_text;
   std::string command =
       sicm_path() + " build " + program.string() + " -o '" + output + "' 2>&1; echo status=$?";
-  std::string text;
-  if (FILE *p = popen(command.c_str(), "r")) {
-    char buf[512];
-    while (std::fgets(buf, sizeof buf, p))
-      text += buf;
-    pclose(p);
-  }
+  std::string text = command_output(command);
   fs::remove(program);
   return text;
 }

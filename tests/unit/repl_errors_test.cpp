@@ -3,6 +3,8 @@
 // with the library's place in a note.
 #include <gtest/gtest.h>
 
+#include "sicm_command.hpp"
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -11,12 +13,8 @@
 
 namespace fs = std::filesystem;
 
-namespace {
-std::string sicm_path() {
-  const char *e = std::getenv("SICM_BINARY");
-  return e && *e ? e : "build/sicm";
-}
-} // namespace
+using sicm_test::command_output;
+using sicm_test::sicm_path;
 
 TEST(ReplErrors, ALibraryErrorIsLocatedAtTheUsersEntry) {
   if (!fs::exists(sicm_path())) GTEST_SKIP() << "no sicm binary at " << sicm_path();
@@ -24,13 +22,7 @@ TEST(ReplErrors, ALibraryErrorIsLocatedAtTheUsersEntry) {
   std::ofstream(input) << "(define ((L-free m) local) (* 1/2 m (square (velocity local))))\n"
                           "((L-free 'm) (up 't 'x))\n";
   std::string command = sicm_path() + " repl < " + input.string() + " 2>&1 >/dev/null";
-  std::string text;
-  if (FILE *p = popen(command.c_str(), "r")) {
-    char buf[512];
-    while (std::fgets(buf, sizeof buf, p))
-      text += buf;
-    pclose(p);
-  }
+  std::string text = command_output(command);
   fs::remove(input);
   EXPECT_NE(text.find("<repl-2>:1:1: error: velocity: the local tuple (up t x) has 2 parts; a "
                       "Lagrangian needs (up t q v)\n    ((L-free 'm) (up 't 'x))\n    ^\n"
