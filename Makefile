@@ -53,7 +53,7 @@ UNIT_SRCS     := $(wildcard tests/unit/*.cpp)
 # The standard library, embedded in the binary; listed in load order.
 STDLIB_FILES  := $(addprefix stdlib/,prelude.sicm local.sicm numerics.sicm lagrangian.sicm \
                    rigid-body.sicm hamiltonian.sicm maps.sicm stability.sicm canonical.sicm \
-                   lie.sicm effects.sicm vector-calculus.sicm)
+                   lie.sicm effects.sicm vector-calculus.sicm plotting.sicm)
 STDLIB_GEN    := $(BUILD)/gen/stdlib_embed.cpp
 
 # The linear solves of kernels, as C text for the C emitter (codegen/emit_c.cpp).
