@@ -24,7 +24,7 @@ TEST(ReplErrors, ALibraryErrorIsLocatedAtTheUsersEntry) {
   std::string command = sicm_path() + " repl < " + input.string() + " 2>&1 >/dev/null";
   std::string text = command_output(command);
   fs::remove(input);
-  EXPECT_NE(text.find("<repl-2>:1:1: error: velocity: the local tuple (up t x) has 2 parts; a "
+  EXPECT_NE(text.find("<repl-2>:1:1: error: velocity: the local tuple has 2 parts; a "
                       "Lagrangian needs (up t q v)\n    ((L-free 'm) (up 't 'x))\n    ^\n"
                       "note: raised inside the library, at <stdlib>/local.sicm:"),
             std::string::npos)
