@@ -20,6 +20,7 @@
 #include "base/primitive.hpp"
 #include "builtins/integration_errors.hpp"
 #include "builtins/numeric_arguments.hpp"
+#include "builtins/numerics.hpp"
 #include "builtins/numerics_defaults.hpp"
 #include "codegen/emit_taylor.hpp"
 #include "codegen/kernel_form.hpp"
@@ -829,6 +830,30 @@ Value P_evolve(Value *a, int n) {
                     &g_build->evolver_lambda);
 }
 
+// ((crossings sysder . params) state event direction t-final ...): no
+// statement of the residual program yet. With every argument known at
+// compile time the crossings are computed now, by sicm run's primitive
+// (the same runtime, the same numbers); a state or time known only at run
+// time cannot compile.
+Value crossings_in_build(NativeProc *self, Value *a, int n) {
+  static const char who[] = "crossings";
+  check_numeric_arguments(who, a, n, self);
+  for (int i = 0; i < n; ++i)
+    if (contains_dynamic(a[i]))
+      cannot_compile(here(), std::string(who) + " of values known only at run time (its " +
+                                 std::to_string(i + 1) +
+                                 (i == 0   ? "st"
+                                  : i == 1 ? "nd"
+                                  : i == 2 ? "rd"
+                                           : "th") +
+                                 " argument): its crossings are found at compile time only");
+  return crossings_now(self, a, n);
+}
+
+Value P_crossings(Value *a, int n) {
+  return make_named(crossings_in_build, sysder_of(a, n, "crossings"), &g_build->crossings_lambda);
+}
+
 } // namespace
 
 // What this file specializes (the table is pe/specialized.cpp).
@@ -841,6 +866,6 @@ const PrimFn
     p_find_root = retrying<traced_or_computed<P_find_root, kFindRoot>>,
     p_nelder_mead = P_nelder_mead,
     p_bisect = retrying<traced_or_computed<bisect_at_run_time, kBisect>>,
-    p_state_advancer = P_state_advancer, p_evolve = P_evolve;
+    p_state_advancer = P_state_advancer, p_evolve = P_evolve, p_crossings = P_crossings;
 
 } // namespace sicm::build

@@ -87,7 +87,7 @@ struct BuildState {
   // they factor and read as the numbers (as sicm run's compile_kernel does)
   std::unordered_map<ExprId, ExprId> parameter_values;
   // what the procedures state-advancer and evolve return print as
-  Lambda advancer_lambda, evolver_lambda;
+  Lambda advancer_lambda, evolver_lambda, crossings_lambda;
 
   // ---- pe/branches.cpp
   std::vector<gcvec<Assignment> *> undo; // logs of assignments to undo, innermost last
