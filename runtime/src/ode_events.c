@@ -39,13 +39,15 @@ typedef struct {
   int cached;
 } step_data;
 
-/* Scratch in o->event_work: ya, fa, fb, y_interp, y_trial, y_best (dim each); g at the samples
+/* Scratch in o->event_work: ya, fa, fb, y_interp, y_trial, y_best, f_mid (dim each), the
+ * interpolant's coefficients (kSlotsCoefficients * dim); g at the samples
  * (event_count * (kSamples + 1)); candidates after them. */
+enum { kSlotMid = 6, kSlotCoefficients = 7, kCoefficients = 6, kSlots = 13 };
 static double *work_slot(sicm_ode *o, int slot) {
   return o->event_work + (size_t)slot * o->dim;
 }
 static double *sample_values(sicm_ode *o) {
-  return o->event_work + 6 * o->dim;
+  return o->event_work + kSlots * o->dim;
 }
 static candidate *candidates(sicm_ode *o) {
   return (candidate *)(void *)(sample_values(o) + o->event_count * (kSamples + 1));
@@ -77,7 +79,7 @@ int sicm_ode_set_events(sicm_ode *o, const sicm_ode_event *events, size_t n,
   o->event_handler = handler;
   o->event_data = data;
   if (n == 0) return SICM_SUCCESS;
-  const size_t doubles = 6 * o->dim + n * (kSamples + 1);
+  const size_t doubles = kSlots * o->dim + n * (kSamples + 1);
   o->events = malloc(n * sizeof *o->events);
   o->event_sign = calloc(n, sizeof *o->event_sign);
   o->event_y_last = malloc(o->dim * sizeof *o->event_y_last);
@@ -173,18 +175,58 @@ static double solution_value(double s, void *params) {
 
 /* ---- the interpolant ----------------------------------------------------- */
 
-/* The cubic Hermite interpolant of the step at ta + s into y. */
+/* The step's interpolant: the quintic through the states at the step's
+ * start, middle and end with the derivatives there (the middle state
+ * integrated from the start, as a trial is), in Newton's form over the
+ * nodes 0, 0, 1/2, 1/2, 1, 1 of theta = s / h. Its error is O(h^6): a
+ * cubic through the ends alone, O(h^4), is off by 1e-3 of a Bulirsch-Stoer
+ * step of half a time unit, enough to misplace a crossing by a sample. */
+static int fit_interpolant(step_data *d) {
+  sicm_ode *o = d->o;
+  const double h = d->tb - d->ta;
+  double *fm = work_slot(o, kSlotMid), *c = work_slot(o, kSlotCoefficients);
+  int status = solve_at(d, 0.5 * h);
+  if (status != SICM_SUCCESS) return status;
+  status = sicm_ode_call_rhs(o, d->ta + 0.5 * h, d->y_trial, fm);
+  if (status == SICM_EUSER) return status;
+  if (status != SICM_SUCCESS) return SICM_EBADFUNC;
+  static const double z[kCoefficients] = {0, 0, 0.5, 0.5, 1, 1};
+  for (size_t i = 0; i < o->dim; i++) {
+    double q[kCoefficients];
+    q[0] = d->ya[i], q[1] = d->ya[i], q[2] = d->y_trial[i], q[3] = d->y_trial[i];
+    q[4] = d->yb[i], q[5] = d->yb[i];
+    /* First divided differences: derivatives at repeated nodes. */
+    const double slope[kCoefficients] = {0,         h * d->fa[i],        (q[2] - q[1]) / 0.5,
+                                         h * fm[i], (q[4] - q[3]) / 0.5, h * d->fb[i]};
+    double col[kCoefficients];
+    for (int j = 1; j < kCoefficients; j++)
+      col[j] = slope[j];
+    c[i * kCoefficients + 0] = q[0];
+    c[i * kCoefficients + 1] = col[1];
+    for (int order = 2; order < kCoefficients; order++) {
+      for (int j = kCoefficients - 1; j >= order; j--)
+        col[j] = (col[j] - col[j - 1]) / (z[j] - z[j - order]);
+      c[i * kCoefficients + order] = col[order];
+    }
+  }
+  return SICM_SUCCESS;
+}
+
+/* The interpolant of the step at ta + s into y. */
 static void interpolate(const step_data *d, double s, double *y) {
   const double h = d->tb - d->ta, theta = s / h;
   if (s == 0 || s == h) {
     memcpy(y, s == 0 ? d->ya : d->yb, d->o->dim * sizeof *y);
     return;
   }
+  const double *c = work_slot(d->o, kSlotCoefficients);
+  static const double z[kCoefficients] = {0, 0, 0.5, 0.5, 1, 1};
   for (size_t i = 0; i < d->o->dim; i++) {
-    const double dy = d->yb[i] - d->ya[i];
-    y[i] = d->ya[i] + theta * dy +
-           theta * (theta - 1) *
-               ((1 - 2 * theta) * dy + (theta - 1) * h * d->fa[i] + theta * h * d->fb[i]);
+    const double *ci = c + i * kCoefficients;
+    double v = ci[kCoefficients - 1];
+    for (int j = kCoefficients - 2; j >= 0; j--)
+      v = ci[j] + (theta - z[j]) * v;
+    y[i] = v;
   }
 }
 
@@ -227,6 +269,47 @@ static int sign_of(double g) {
  * the solution; else the samples' bracket does; and if the solution does
  * not change sign between the samples (the interpolant was off), the
  * solution at tau is taken. */
+/* The direction of the crossing between values g_a at s_a and g_b at s_b
+ * of opposite signs. */
+static int direction_between(double s_a, double g_a, double s_b, double g_b) {
+  const double later = s_b > s_a ? g_b : g_a;
+  return later > 0 ? SICM_ODE_EVENT_UP : SICM_ODE_EVENT_DOWN;
+}
+
+/* When the solution does not change sign where the interpolant does: the
+ * change of sign of the solution in the candidate's direction nearest to
+ * tau among the step's sample times, in [*lo, *hi] with their values;
+ * 0 if there is none (the interpolant's crossing was an artefact of its
+ * error: a graze, which the solution does not make). */
+static int scan_solution(step_data *d, const candidate *c, double s0, double *lo, double *g_lo,
+                         double *hi, double *g_hi) {
+  const double h = d->tb - d->ta;
+  const double *g = sample_values(d->o) + c->k * (kSamples + 1);
+  double s_prev = 0, g_prev = g[0], best = INFINITY;
+  int found = 0;
+  for (int j = 1; j <= kSamples; j++) {
+    const double sj = j == kSamples ? h : j * h / kSamples;
+    const double gj = j == kSamples ? g[kSamples] : solution_value(sj, d);
+    if (d->status != SICM_SUCCESS) return 0;
+    if (gj == 0) continue;
+    if (g_prev != 0 && sign_of(gj) != sign_of(g_prev) &&
+        direction_between(s_prev, g_prev, sj, gj) == c->dir &&
+        fabs(0.5 * (s_prev + sj) - s0) < best) {
+      best = fabs(0.5 * (s_prev + sj) - s0);
+      *lo = s_prev, *g_lo = g_prev, *hi = sj, *g_hi = gj;
+      found = 1;
+    }
+    s_prev = sj, g_prev = gj;
+  }
+  return found;
+}
+
+/* Places candidate c on the solution: d->s_best and d->y_best; returns the
+ * status, or kNoCrossing. The interpolant's root tau starts the search; a
+ * Newton step from it on the interpolant's slope usually gives, with tau, a
+ * bracket a few ulps wide on the solution; else the samples' bracket does;
+ * else the solution is sampled itself (scan_solution). */
+enum { kNoCrossing = -1 };
 static int place(step_data *d, const candidate *c) {
   const double h = d->tb - d->ta;
   const double s_lo = (double)c->lo / kSamples * h,
@@ -246,7 +329,7 @@ static int place(step_data *d, const candidate *c) {
     const double s1 = fmin(fmax(s0 - 2 * g0 / slope, fmin(s_lo, s_hi)), fmax(s_lo, s_hi));
     const double g1 = solution_value(s1, d);
     if (d->status != SICM_SUCCESS || g1 == 0) return d->status;
-    if (sign_of(g1) != sign_of(g0)) {
+    if (sign_of(g1) != sign_of(g0) && direction_between(s0, g0, s1, g1) == c->dir) {
       lo = s0, g_lo = g0, hi = s1, g_hi = g1;
     }
   }
@@ -255,24 +338,26 @@ static int place(step_data *d, const candidate *c) {
     g_hi = solution_value(s_hi, d);
     if (d->status != SICM_SUCCESS) return d->status;
     if (g_lo == 0 || g_hi == 0) return SICM_SUCCESS; /* on a sample: the best trial */
-    if (sign_of(g_lo) == sign_of(g_hi)) {
-      /* No sign change of the solution here: the crossing is where the
-       * interpolant puts it. */
-      d->status = SICM_SUCCESS;
-      solution_value(s0, d);
-      d->s_best = s0;
-      memcpy(d->y_best, d->y_trial, d->o->dim * sizeof *d->y_trial);
-      return d->status;
-    }
-    if (sign_of(g0) == sign_of(g_lo))
+    if (sign_of(g_lo) == sign_of(g_hi) || direction_between(s_lo, g_lo, s_hi, g_hi) != c->dir) {
+      if (!scan_solution(d, c, s0, &lo, &g_lo, &hi, &g_hi))
+        return d->status != SICM_SUCCESS ? d->status : kNoCrossing;
+    } else if (sign_of(g0) == sign_of(g_lo)) {
       lo = s0, g_lo = g0;
-    else
+    } else {
       hi = s0, g_hi = g0;
+    }
   }
+  d->have_best = 0; /* the crossing is in [lo, hi]: only trials there count */
   d->cache_s[0] = lo, d->cache_g[0] = g_lo;
   d->cache_s[1] = hi, d->cache_g[1] = g_hi;
   d->cached = 2;
   brent(solution_value, d, lo, hi, h, &d->status);
+  if (d->status == SICM_SUCCESS && !d->have_best) {
+    /* Brent evaluated nothing new: the bracket was already tight; take
+     * the end with the smaller |g|. */
+    d->cached = 0;
+    solution_value(fabs(g_lo) <= fabs(g_hi) ? lo : hi, d);
+  }
   return d->status;
 }
 
@@ -297,6 +382,11 @@ static int events_of_step(step_data *d, double *t, double *y) {
   const double h = d->tb - d->ta;
   double *g = sample_values(o);
   double *yi = work_slot(o, 3);
+  int status = fit_interpolant(d);
+  if (status == SICM_EUSER) return sicm_ode_fail_user(o, d->ta, d->ya);
+  if (status != SICM_SUCCESS)
+    return sicm_ode_fail(o, status, d->ta, d->ya, "cannot interpolate the step for its events",
+                         sicm_ode_last_error(o->event_solver));
   for (int j = 0; j <= kSamples; j++) {
     const double s = j == kSamples ? h : j * h / kSamples;
     interpolate(d, s, yi);
@@ -331,7 +421,8 @@ static int events_of_step(step_data *d, double *t, double *y) {
   }
   qsort(cs, count, sizeof *cs, compare_candidates);
   for (size_t c = 0; c < count; c++) {
-    int status = place(d, &cs[c]);
+    status = place(d, &cs[c]);
+    if (status == kNoCrossing) continue;
     if (status == SICM_EBADFUNC && d->have_best)
       return fail_event(o, d->ta + d->s_best, d->y_trial, cs[c].k);
     if (status == SICM_EUSER) return sicm_ode_fail_user(o, d->ta, d->ya);

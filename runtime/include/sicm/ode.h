@@ -240,15 +240,20 @@ int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y);
  * those the method's controller chooses; for CVODE, the Taylor methods and
  * the fixed-step methods, spans of the size a 4th-order method would take
  * first), and after each step [ta, tb] it looks for sign changes of each g on
- * a continuous extension of the step: the cubic Hermite interpolant of the
- * step's end states and derivatives, sampled at
- * SICM_ODE_EVENT_SAMPLES equal sub-intervals so that two crossings in one
- * step are both found. Each sign change is placed by Brent's method, first
+ * a continuous extension of the step: the quintic Hermite interpolant of the
+ * states and derivatives at the step's start, middle and end (the middle
+ * state integrated from the start, which costs about a step more), sampled
+ * at SICM_ODE_EVENT_SAMPLES equal sub-intervals, so that two crossings in
+ * one step are both found. Each sign change is placed by Brent's method, first
  * on the interpolant, then on the solution itself: each trial time is
  * reached by integrating from the step's start with the same method and
  * tolerances, so a located event is as accurate as the integration (the
- * interpolant only brackets it). Its time is found to a few ulps: of the
- * two ends of the last bracket, the one where |g| is smaller.
+ * interpolant only brackets it), to a few ulps of the time since the
+ * step's start (the trial integrations run in that time, so the state at
+ * a crossing late in a long run is on it to the resolution of the step,
+ * not of t). Where the solution does not change sign as the interpolant
+ * does, the solution itself is sampled; if it does not change sign there
+ * either, there is no event (a graze of the interpolant's making).
  *
  * The located events of a step are handled in time order: the handler, if
  * any, gets the event's index, time and state; it returns 0 to go on, or
