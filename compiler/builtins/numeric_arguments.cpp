@@ -146,11 +146,12 @@ const std::vector<NumericSignature> &numeric_signatures() {
        4,
        7,
        {R::Any, R::Procedure, R::Finite, R::Finite, R::Tolerance, R::Integrator, R::Count}},
-      // ((crossings sysder . params) state event direction t-final [tolerance [integrator]])
+      // ((crossings sysder . params) state event direction t-final [tolerance [integrator
+      // [count]]])
       {"crossings",
        4,
-       6,
-       {R::Any, R::Procedure, R::Direction, R::Finite, R::Tolerance, R::Integrator}},
+       7,
+       {R::Any, R::Procedure, R::Direction, R::Finite, R::Tolerance, R::Integrator, R::Count}},
   };
   return table;
 }

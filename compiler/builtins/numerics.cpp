@@ -810,6 +810,7 @@ struct EventCallback : Callback {
   Value event;
   const StateShape *shape;
   gcvec<Value> found;
+  size_t most = 0; // stop after this many crossings (0: no limit)
   EventCallback(SrcLoc l, const char *w, Value e, const StateShape *s)
       : Callback(l, w), event(e), shape(s) {}
 };
@@ -834,7 +835,7 @@ double call_event(double, const double *y, void *data) {
 int record_crossing(size_t, double, const double *y, void *data) {
   auto *cb = static_cast<EventCallback *>(data);
   cb->found.push_back(cb->shape->build(y));
-  return 0;
+  return cb->most && cb->found.size() >= cb->most; // non-zero: the integration stops here
 }
 
 // The runtime's direction of an event: 'up, 'down or 'both
@@ -846,10 +847,11 @@ int event_direction(Value v) {
                           : SICM_ODE_EVENT_BOTH;
 }
 
-// ((crossings sysder . params) state event direction t-final [eps [integrator]]):
-// the states where (event state) crosses 0 in direction between the
-// state's time and t-final, in time order, located inside the integrator
-// (sicm_ode_set_events).
+// ((crossings sysder . params) state event direction t-final [eps [integrator
+// [count]]]): the states where (event state) crosses 0 in direction between
+// the state's time and t-final, in time order, located inside the integrator
+// (sicm_ode_set_events); the first count of them only, the integration
+// stopping at the last, when count is given.
 Value run_crossings(NativeProc *self, Value *a, int n) {
   static const char who[] = "crossings";
   check_numeric_arguments(who, a, n, self);
@@ -863,6 +865,7 @@ Value run_crossings(NativeProc *self, Value *a, int n) {
   OdeProblem p(loc, who, self->a, a[0], 1,
                T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended);
   EventCallback events(loc, who, a[1], &p.shape);
+  events.most = is_missing(a, n, 6) ? 0 : static_cast<size_t>(a[6].i);
   {
     RuntimeErrorScope scope;
     OdePtr ode = p.make_integrator(T, eps, 0);
