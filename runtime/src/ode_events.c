@@ -270,9 +270,10 @@ static int sign_of(double g) {
  * not change sign between the samples (the interpolant was off), the
  * solution at tau is taken. */
 /* The direction of the crossing between values g_a at s_a and g_b at s_b
- * of opposite signs. */
+ * of opposite signs: later is further from the step's start, whichever way
+ * the integration runs (s has the sign of the step). */
 static int direction_between(double s_a, double g_a, double s_b, double g_b) {
-  const double later = s_b > s_a ? g_b : g_a;
+  const double later = fabs(s_b) > fabs(s_a) ? g_b : g_a;
   return later > 0 ? SICM_ODE_EVENT_UP : SICM_ODE_EVENT_DOWN;
 }
 

@@ -177,6 +177,27 @@ TEST(OdeEvents, TaylorMethodFindsTheZeros) {
   sicm_ode_free(o);
 }
 
+// Backwards in time, "up" is still from negative to positive as the integration proceeds: x = sin
+// t, negative just before t = 0, goes up through 0 at -pi, -3 pi, ... (where v = cos t = -1).
+TEST(OdeEvents, BackwardsIntegration) {
+  for (const sicm_ode_step_type *T : {sicm_ode_step_rk8pd, sicm_ode_step_bs}) {
+    SCOPED_TRACE(sicm_ode_step_type_name(T));
+    std::vector<Located> found;
+    event_dim = 2;
+    sicm_ode *o = sicm_ode_alloc(T, 2, oscillator, nullptr, 1e-14, 1e-14);
+    sicm_ode_event event = {position, nullptr, SICM_ODE_EVENT_UP, 0};
+    ASSERT_EQ(sicm_ode_set_events(o, &event, 1, record, &found), SICM_SUCCESS);
+    double t = 0, y[2] = {0, 1};
+    ASSERT_EQ(sicm_ode_evolve(o, &t, -10 * M_PI - 1, y), SICM_SUCCESS) << sicm_ode_last_error(o);
+    ASSERT_EQ(found.size(), 5u);
+    for (size_t k = 0; k < found.size(); k++) {
+      EXPECT_NEAR(found[k].t, -(2.0 * k + 1) * M_PI, 1e-12) << k;
+      EXPECT_NEAR(found[k].y[1], -1, 1e-12) << k;
+    }
+    sicm_ode_free(o);
+  }
+}
+
 // A terminal event stops the integration at the crossing; an integration resumed from there
 // does not find it again, and stops at the next one.
 TEST(OdeEvents, TerminalEventStopsAndResumes) {
