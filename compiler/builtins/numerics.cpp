@@ -1,6 +1,6 @@
 // Numerical primitives: definite-integral, minimize, nelder-mead,
 // multidimensional-minimize, find-root, bisect, state-advancer, evolve,
-// eigenvalues.
+// crossings, eigenvalues.
 //
 // The runtime's numerical modules (runtime/include/sicm/*.h) work on C
 // functions of doubles. Here those functions are callbacks that apply a
