@@ -453,7 +453,19 @@ static int events_of_step(step_data *d, double *t, double *y) {
   return SICM_SUCCESS;
 }
 
+static int evolve_events(sicm_ode *o, double *t, double t1, double *y);
+
+/* GSL's root solver reports a non-finite value of the function (an event
+ * function that failed) through GSL's error handler, whose default aborts:
+ * off while events are sought, the failure is this call's to report. */
 int sicm_ode_evolve_events(sicm_ode *o, double *t, double t1, double *y) {
+  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  const int status = evolve_events(o, t, t1, y);
+  gsl_set_error_handler(old);
+  return status;
+}
+
+static int evolve_events(sicm_ode *o, double *t, double t1, double *y) {
   const size_t dim = o->dim, n = o->event_count;
   if (!isfinite(*t) || !isfinite(t1) || !sicm_ode_finite(dim, y) || *t == t1)
     return sicm_ode_evolve_plain(o, t, t1, y); /* its checks and messages */
