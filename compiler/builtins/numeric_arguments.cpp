@@ -71,6 +71,11 @@ void check_argument(ArgRule rule, Value *a, int i, const char *who) {
     return;
   case R::Integrator: check_integrator(a, i, who); return;
   case R::Point: check_point(a, i, who); return;
+  case R::Direction:
+    if (!is_symbol(v) ||
+        (symbol_name(v) != "up" && symbol_name(v) != "down" && symbol_name(v) != "both"))
+      bad_range(v, i + 1, who, "a direction is 'up, 'down or 'both");
+    return;
   default: break;
   }
   // A tolerance is compiled into the program; the other numbers the
@@ -137,8 +142,16 @@ const std::vector<NumericSignature> &numeric_signatures() {
       // ((evolve sysder . params) state monitor dt t-final [tolerance
       // [integrator [max-steps]]]); a step of 0 is the monitor schedule's to refuse
       // (sicm_monitor_schedule_start), after the first call of the monitor.
-      {"evolve", 4, 7,
+      {"evolve",
+       4,
+       7,
        {R::Any, R::Procedure, R::Finite, R::Finite, R::Tolerance, R::Integrator, R::Count}},
+      // ((crossings sysder . params) state event direction t-final [tolerance [integrator
+      // [count]]])
+      {"crossings",
+       4,
+       7,
+       {R::Any, R::Procedure, R::Direction, R::Finite, R::Tolerance, R::Integrator, R::Count}},
   };
   return table;
 }

@@ -32,6 +32,7 @@ enum class ArgRule {
   Count,       // an exact integer from 1 to 100000000
   Point,       // a non-empty list or vector of finite reals
   Integrator,  // a symbol naming an integrator (the message lists them)
+  Direction,   // the symbol up, down or both (a crossing's direction)
 };
 
 struct NumericSignature {

@@ -1,6 +1,6 @@
 // Numerical primitives: definite-integral, minimize, nelder-mead,
 // multidimensional-minimize, find-root, bisect, state-advancer, evolve,
-// eigenvalues.
+// crossings, eigenvalues.
 //
 // The runtime's numerical modules (runtime/include/sicm/*.h) work on C
 // functions of doubles. Here those functions are callbacks that apply a
@@ -801,6 +801,99 @@ Value P_evolve(Value *a, int n) {
   return make_named_procedure(run_evolve, apply_sysder(a, n, "evolve"), &g_evolver_lambda);
 }
 
+// ---- crossings ----------------------------------------------------------------------
+
+// The event procedure of crossings: a real function of the state, computed
+// by the interpreter (flonums stay flonums, as sicm build's residual
+// function of it computes), and the states at the crossings found.
+struct EventCallback : Callback {
+  Value event;
+  const StateShape *shape;
+  gcvec<Value> found;
+  size_t most = 0; // stop after this many crossings (0: no limit)
+  EventCallback(SrcLoc l, const char *w, Value e, const StateShape *s)
+      : Callback(l, w), event(e), shape(s) {}
+};
+
+double call_event(double, const double *y, void *data) {
+  auto *cb = static_cast<EventCallback *>(data);
+  if (cb->error) return NAN;
+  try {
+    Value state = cb->shape->build(y);
+    Value g = apply_procedure(cb->event, &state, 1);
+    if (!is_number(g) || !is_real(g))
+      runtime_error(cb->loc, std::string(cb->who) + ": the event procedure returned " +
+                                 write_string(g) + " for the state " + write_string(state) +
+                                 ", which is not a real number");
+    return to_double(g);
+  } catch (...) {
+    cb->error = std::current_exception();
+    return NAN;
+  }
+}
+
+int record_crossing(size_t, double, const double *y, void *data) {
+  auto *cb = static_cast<EventCallback *>(data);
+  cb->found.push_back(cb->shape->build(y));
+  return cb->most && cb->found.size() >= cb->most; // non-zero: the integration stops here
+}
+
+// The runtime's direction of an event: 'up, 'down or 'both
+// (check_numeric_arguments has checked the symbol).
+int event_direction(Value v) {
+  const std::string &name = symbol_name(v);
+  return name == "up"     ? SICM_ODE_EVENT_UP
+         : name == "down" ? SICM_ODE_EVENT_DOWN
+                          : SICM_ODE_EVENT_BOTH;
+}
+
+// ((crossings sysder . params) state event direction t-final [eps [integrator
+// [count]]]): the states where (event state) crosses 0 in direction between
+// the state's time and t-final, in time order, located inside the integrator
+// (sicm_ode_set_events); the first count of them only, the integration
+// stopping at the last, when count is given.
+Value run_crossings(NativeProc *self, Value *a, int n) {
+  static const char who[] = "crossings";
+  check_numeric_arguments(who, a, n, self);
+  SrcLoc loc = current_call_loc();
+  check_monitor_arity(loc, who, a[1]);
+  const int direction = event_direction(a[2]);
+  double t_final = real_at(a, 3);
+  double eps = optional_real(a, n, 4, kAdvancerTolerance);
+  const sicm_ode_step_type *T = arg_integrator(a, n, 5, who);
+  check_reachable_tolerance(loc, who, T, eps);
+  OdeProblem p(loc, who, self->a, a[0], 1,
+               T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended);
+  EventCallback events(loc, who, a[1], &p.shape);
+  events.most = is_missing(a, n, 6) ? 0 : static_cast<size_t>(a[6].i);
+  {
+    RuntimeErrorScope scope;
+    OdePtr ode = p.make_integrator(T, eps, 0);
+    const sicm_ode_event event = {call_event, &events, direction, 0};
+    sicm_ode_set_events(ode.get(), &event, 1, record_crossing, &events);
+    double t = p.t0;
+    const int status = sicm_ode_evolve(ode.get(), &t, t_final, p.y.data());
+    p.cb.rethrow_if_failed();
+    events.rethrow_if_failed();
+    if (status != SICM_SUCCESS) numeric_error(loc, who, sicm_ode_last_error(ode.get()));
+  }
+  return list_from(events.found.data(), events.found.size());
+}
+
+Lambda g_crossings_lambda;
+
+} // namespace
+
+Value crossings_now(NativeProc *self, Value *a, int n) {
+  return run_crossings(self, a, n);
+}
+
+namespace {
+
+Value P_crossings(Value *a, int n) {
+  return make_named_procedure(run_crossings, apply_sysder(a, n, "crossings"), &g_crossings_lambda);
+}
+
 // ---- quadrature -------------------------------------------------------------------
 
 // A limit of integration: a real, or :+infinity / :-infinity.
@@ -1089,6 +1182,7 @@ void install_numerics_primitives() {
   define_global("*ode-integration-method*", intern("bulirsch-stoer"));
   g_advancer_lambda.name = intern("state-advancer").symbol();
   g_evolver_lambda.name = intern("evolve").symbol();
+  g_crossings_lambda.name = intern("crossings").symbol();
 
   define_primitive("definite-integral", 3, 5, Stage::RunTime, P_definite_integral);
   define_primitive("minimize", 3, 4, Stage::RunTime, P_minimize);
@@ -1099,6 +1193,7 @@ void install_numerics_primitives() {
   define_primitive("bisect", 4, 5, Stage::RunTime, P_bisect);
   define_primitive("state-advancer", 1, kVariadic, Stage::RunTime, P_state_advancer);
   define_primitive("evolve", 1, kVariadic, Stage::RunTime, P_evolve);
+  define_primitive("crossings", 1, kVariadic, Stage::RunTime, P_crossings);
   define_primitive("eigenvalues", 1, 1, Stage::Pure, P_eigenvalues);
   define_primitive("matrix->eigenvalues", 1, 1, Stage::Pure, P_eigenvalues);
 }

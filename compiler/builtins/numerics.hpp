@@ -33,4 +33,12 @@ using SystemCompiler = CompiledFn (*)(Value sysder, Value state, const char *who
                                       std::string *why_not);
 void set_system_compiler(SystemCompiler compiler);
 
+struct NativeProc;
+
+// The call of the procedure (crossings sysder . params) returns, self being
+// that procedure: the states at the crossings, computed now. sicm build
+// calls it at compile time when every argument is known then
+// (pe/numerics.cpp), so that both modes compute the same numbers.
+Value crossings_now(NativeProc *self, Value *a, int n);
+
 } // namespace sicm

@@ -125,6 +125,7 @@ void find_uses(const std::vector<RStmt> &body, std::map<int, Use> &uses) {
     };
     switch (s.kind) {
     case RKind::Evolve:
+    case RKind::Crossings:
     case RKind::Advance: note(s.callee, "state-derivative"); break;
     case RKind::Integral: note(s.callee, "integrand"); break;
     case RKind::Minimize:

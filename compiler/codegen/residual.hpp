@@ -87,6 +87,8 @@ enum class RKind : uint8_t {
   Bisect,      // outs[0] = root of callee between args[0], args[1] to args[2]; number n-break
   Advance,     // outs = state args advanced by args.back() (dt); callee the derivative
   Evolve,      // outs = final state from args[0..dim) with monitor; dt t_final at the end
+  Crossings,   // list `list` = the states from args[0..dim) to args.back() (t_final) where the
+               // function `monitor` of the state crosses 0 in `direction`, at most `count`
   ListNew,     // list `list` = the empty list
   ListPush,    // add args (an element's leaves) to list `list`
   ListConst,   // list `list` = the elements of the constant table `leaf`
@@ -110,11 +112,12 @@ struct RStmt {
   int var = -1;             // Let, Print
   int plot = -1;            // plot statements: the plot's number
   int callee = -1;          // the function a numerical statement calls
-  int monitor = -1;         // Evolve: the monitor function, or -1
+  int monitor = -1;         // Evolve: the monitor function, or -1; Crossings: the event
+  int direction = 0;        // Crossings: SICM_ODE_EVENT_UP, _DOWN or _BOTH
   int first_monitor = -1;   // Evolve: the monitor for the initial state as written (exact
                             // numbers), or -1: monitor
   std::vector<int> members; // ParallelMap: the members' functions (one for all, or one each)
-  int count = 0;            // ParallelMap: the number of members
+  int count = 0;            // ParallelMap: the number of members; Crossings: the most, 0: all
   int jacobian = -1;        // Advance, Evolve: (D sysder) for implicit methods
   int probe = -1;           // Advance, Evolve: what sysder divides by, or -1
   int cell = -1;            // SetCell, Let of ReadCell

@@ -285,6 +285,7 @@ private:
       break;
     case RKind::Advance:
     case RKind::Evolve: ode(s); break;
+    case RKind::Crossings: crossings(s); break;
     case RKind::ListNew: list(s); break;
     case RKind::ListPush:
       list(s);
@@ -317,10 +318,26 @@ private:
               "a comparison's variable r" + std::to_string(s.var) + " is not a truth value");
   }
 
+  // Crossings: the state's leaves, then the final time, as Advance's; the
+  // event a function of the state with one output, the list one of states.
+  void crossings(const RStmt &s) {
+    require(s.outs.empty(), "defines variables (its result is its list)");
+    ode(s);
+    callee(s.monitor, "event", false);
+    const RFunction &event = p_.functions[static_cast<size_t>(s.monitor)];
+    require(event.inputs.size() + 1 == s.args.size() && event.outputs.size() == 1,
+            "its event f" + std::to_string(s.monitor) + " is not a number of the state");
+    list(s);
+    require(static_cast<size_t>(p_.lists[static_cast<size_t>(s.list)].width) + 1 == s.args.size(),
+            "its list's elements are not states");
+    require(s.direction >= 1 && s.direction <= 3, "has no direction");
+    require(s.count >= 0, "has a negative count");
+  }
+
   // Advance: the state's leaves, then dt; Evolve: the state's leaves, dt
   // and the final time. The system derivative maps the state to its rate.
   void ode(const RStmt &s) {
-    size_t extra = s.kind == RKind::Advance ? 1 : 2;
+    size_t extra = s.kind == RKind::Evolve ? 2 : 1;
     require(s.args.size() >= extra, "has no state");
     size_t dim = s.args.size() - extra;
     require(s.outs.size() <= dim, "defines more results than the state has leaves");
@@ -329,8 +346,10 @@ private:
     const RFunction &sys = p_.functions[static_cast<size_t>(s.callee)];
     require(sys.inputs.size() == dim && sys.outputs.size() == dim,
             "its system derivative f" + std::to_string(s.callee) + " is not of the state's size");
-    callee(s.monitor, "monitor", true);
-    require(s.kind == RKind::Evolve || s.monitor == -1, "advance has a monitor");
+    if (s.kind != RKind::Crossings) {
+      callee(s.monitor, "monitor", true);
+      require(s.kind == RKind::Evolve || s.monitor == -1, "advance has a monitor");
+    }
     callee(s.first_monitor, "first monitor", true);
     require(s.first_monitor == -1 || s.monitor >= 0, "has a first monitor but no monitor");
     // A kernel (emitted as plain C, as sicm run's JIT kernels) is one DAG.

@@ -183,6 +183,7 @@ const char *statement_kind_name(RKind k) {
   case RKind::Bisect: return "bisect";
   case RKind::Advance: return "state-advancer";
   case RKind::Evolve: return "evolve";
+  case RKind::Crossings: return "crossings";
   case RKind::ListNew: return "list-new";
   case RKind::ListPush: return "list-push";
   case RKind::ListConst: return "list-const";

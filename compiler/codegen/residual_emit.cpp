@@ -493,6 +493,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     case RKind::Multimin: return multimin(f, s, prefix);
     case RKind::Advance:
     case RKind::Evolve: return advance_or_evolve(f, s, prefix);
+    case RKind::Crossings: return crossings(s, prefix);
     case RKind::ParallelMap: {
       std::string code;
       std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
@@ -704,6 +705,21 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     return code;
   }
 
+  // Crossings' operands are the state then the final time; the states at
+  // the crossings go to its list.
+  std::string crossings(const RStmt &s, const std::string &prefix) {
+    std::string code;
+    std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
+    size_t dim = a.size() - 1;
+    std::string y = prefix + "y";
+    code += "double " + y + "[] = {" + join({a.begin(), a.begin() + dim}) + "};\n";
+    code += "sicm_drive_crossings(" + site(s.loc) + ", &" + ode(s, dim) + ", " +
+            closure(s.monitor) + ", " + std::to_string(s.direction) + ", " +
+            std::to_string(s.count) + ", " + y + ", " + a[dim] + ", &list" +
+            std::to_string(s.list) + ");\n";
+    return code;
+  }
+
   // Continue and Break: every new value is computed before any is
   // assigned (one may read another's old value), then the jump.
   std::string loop_exit(const RStmt &s, const std::string &prefix, const std::vector<int> &targets,
@@ -771,6 +787,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       case RKind::ListNew:
       case RKind::ListPush:
       case RKind::ListConst:
+      case RKind::Crossings:
       case RKind::Frame:
       case RKind::Close: return true;
       default: break;

@@ -839,6 +839,7 @@ void begin_build_mode(build::BuildState *state) {
   g_build->open = {0};
   g_build->advancer_lambda.name = intern("state-advancer").symbol();
   g_build->evolver_lambda.name = intern("evolve").symbol();
+  g_build->crossings_lambda.name = intern("crossings").symbol();
 
   for (const Specialization &p : specializations()) {
     Symbol *s = intern(p.name).symbol();

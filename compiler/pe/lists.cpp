@@ -90,7 +90,8 @@ std::vector<RType> leaf_types(const gcvec<Value> &leaves) {
   return types;
 }
 
-// A new empty list for elements shaped like `shape`.
+} // namespace
+
 int new_list(Value shape, const std::vector<RType> &types, const std::string &name) {
   int id = static_cast<int>(g_build->program.lists.size());
   g_build->program.lists.push_back(RList{static_cast<int>(types.size()), name});
@@ -101,6 +102,8 @@ int new_list(Value shape, const std::vector<RType> &types, const std::string &na
   emit(std::move(s));
   return id;
 }
+
+namespace {
 
 void push_leaves(int list, const gcvec<Value> &leaves) {
   RStmt s{RKind::ListPush};

@@ -1,6 +1,6 @@
 // `sicm build`'s numerical primitives: definite-integral, minimize,
-// multidimensional-minimize, find-root, bisect, state-advancer and evolve
-// record a statement of the residual program and return fresh run-time
+// multidimensional-minimize, find-root, bisect, state-advancer, evolve and
+// crossings record a statement of the residual program and return fresh run-time
 // values. The procedures they are given (an integrand, an objective, a
 // system derivative, a monitor) are traced into functions of the residual
 // program, which the statement calls. Part of build mode (the design is in
@@ -20,6 +20,7 @@
 #include "base/primitive.hpp"
 #include "builtins/integration_errors.hpp"
 #include "builtins/numeric_arguments.hpp"
+#include "builtins/numerics.hpp"
 #include "builtins/numerics_defaults.hpp"
 #include "codegen/emit_taylor.hpp"
 #include "codegen/kernel_form.hpp"
@@ -30,6 +31,7 @@
 #include "pe/specialized.hpp"
 #include "pe/state.hpp"
 #include "print/printer.hpp"
+#include "sicm/runtime.h"
 
 namespace sicm::build {
 
@@ -848,6 +850,66 @@ Value P_evolve(Value *a, int n) {
                     &g_build->evolver_lambda);
 }
 
+// ((crossings sysder . params) state event direction t-final [tolerance
+// [integrator [count]]]): with every argument known at compile time the
+// crossings are computed now, by sicm run's primitive (the same runtime,
+// the same numbers: a list known at compile time, which prints); else a
+// Crossings statement whose states go to a run-time list (which walks,
+// counts and maps, but does not print, as such lists do: pe/lists.cpp).
+Value crossings_in_build(NativeProc *self, Value *a, int n) {
+  static const char who[] = "crossings";
+  check_numeric_arguments(who, a, n, self);
+  bool known = true;
+  for (int i = 0; i < n; ++i)
+    if (contains_dynamic(a[i])) known = false;
+  if (known) return crossings_now(self, a, n);
+  check_monitor_arity(here(), who, a[1]);
+  RStmt s{RKind::Crossings};
+  s.loc = here();
+  s.number = static_number(a, n, 4, kAdvancerTolerance, who);
+  s.method = method_of(a, n, 5, who);
+  check_reachable_tolerance(s.loc, who, integrator_of_c_name(s.method), s.number);
+  s.count = static_cast<int>(static_count(a, n, 6));
+  const std::string &direction = symbol_name(a[2]);
+  s.direction = direction == "up"     ? SICM_ODE_EVENT_UP
+                : direction == "down" ? SICM_ODE_EVENT_DOWN
+                                      : SICM_ODE_EVENT_BOTH;
+  state_args(a[0], s, who);
+  s.args.push_back(expr_of(a[3], who));
+  trace_system(self->a, a[0], s, who);
+  check_taylor(s, who);
+  trace_singular_factors(a[0], s);
+  trace_jacobian(self->a, a[0], s);
+  {
+    // The event, a function of the state computing as the interpreter
+    // computes, as sicm run interprets it.
+    FunctionScope scope(procedure_name(a[1]));
+    Value x = input_like(a[0]);
+    Value g = apply_procedure(a[1], &x, 1);
+    if (!is_number(g) && !is_dynamic_scalar(g))
+      cannot_compile(s.loc, std::string(who) + ": the event procedure returns " + describe(g) +
+                                ", not a number");
+    current().outputs.push_back(expr_of(g, who));
+    s.monitor = scope.id();
+  }
+  gcvec<Value> leaves;
+  state_leaves(a[0], leaves);
+  s.list = new_list(inexact_leaves(a[0]), std::vector<RType>(leaves.size(), RType::Real), who);
+  const int list = s.list;
+  emit(std::move(s));
+  RStmt length{RKind::Let};
+  length.compute = RCompute::ListLength;
+  length.list = list;
+  Value count = new_var(RType::Integer);
+  length.var = var_of(count);
+  current_block().push_back(std::move(length));
+  return make_rtlist(list, true, false, Value::fixnum(0), count); // in push order
+}
+
+Value P_crossings(Value *a, int n) {
+  return make_named(crossings_in_build, sysder_of(a, n, "crossings"), &g_build->crossings_lambda);
+}
+
 } // namespace
 
 // What this file specializes (the table is pe/specialized.cpp).
@@ -860,6 +922,6 @@ const PrimFn
     p_find_root = retrying<traced_or_computed<P_find_root, kFindRoot>>,
     p_nelder_mead = P_nelder_mead,
     p_bisect = retrying<traced_or_computed<bisect_at_run_time, kBisect>>,
-    p_state_advancer = P_state_advancer, p_evolve = P_evolve;
+    p_state_advancer = P_state_advancer, p_evolve = P_evolve, p_crossings = P_crossings;
 
 } // namespace sicm::build

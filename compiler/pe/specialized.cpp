@@ -76,6 +76,7 @@ const std::vector<Specialization> &specializations() {
       {"bisect", 4, 5, p_bisect},
       {"state-advancer", 1, kVariadic, p_state_advancer},
       {"evolve", 1, kVariadic, p_evolve},
+      {"crossings", 1, kVariadic, p_crossings},
 
       // Plots record statements (pe/plots.cpp).
       {"frame", 4, 7, p_frame},

@@ -48,7 +48,7 @@ extern const PrimFn p_divide, p_sqrt, p_log, p_asin, p_acos, p_expt;
 
 // ---- pe/numerics.cpp: the numerical primitives record statements ------------------------
 extern const PrimFn p_definite_integral, p_minimize, p_brent_min, p_multidimensional_minimize,
-    p_find_root, p_nelder_mead, p_bisect, p_state_advancer, p_evolve;
+    p_find_root, p_nelder_mead, p_bisect, p_state_advancer, p_evolve, p_crossings;
 
 // ---- pe/plots.cpp: plots record statements ----------------------------------------------
 extern const PrimFn p_frame, p_plot_point, p_plot_line, p_graphics_close, p_graphics_clear;

@@ -87,7 +87,7 @@ struct BuildState {
   // they factor and read as the numbers (as sicm run's compile_kernel does)
   std::unordered_map<ExprId, ExprId> parameter_values;
   // what the procedures state-advancer and evolve return print as
-  Lambda advancer_lambda, evolver_lambda;
+  Lambda advancer_lambda, evolver_lambda, crossings_lambda;
 
   // ---- pe/branches.cpp
   std::vector<gcvec<Assignment> *> undo; // logs of assignments to undo, innermost last
@@ -309,6 +309,9 @@ bool is_whole_list(Value v);
 bool element_leaves(Value v, gcvec<Value> &out);
 // The shape of an element: its leaves replaced by 0.
 Value element_shape(Value element);
+// A new empty run-time list for elements shaped like `shape` with leaves of
+// `types` (a ListNew statement); its id.
+int new_list(Value shape, const std::vector<RType> &types, const std::string &name);
 // (set! l (cons element l)) where l must become or is a run-time list.
 Value push_onto_list(Value *place, const std::string &name, Value element, SrcLoc loc,
                      bool may_create, Frame *frame, bool in_loop);

@@ -469,6 +469,7 @@ sicm_ode *sicm_ode_alloc(const sicm_ode_step_type *T, size_t dim, sicm_ode_rhs f
                     .params = params,
                     .abs_tol = abs_tol,
                     .rel_tol = rel_tol,
+                    .stopping_event = -1,
                     .max_steps = kDefaultMaxSteps};
     o->y_last = malloc(dim * sizeof *o->y_last);
   }
@@ -487,6 +488,7 @@ sicm_ode *sicm_ode_alloc(const sicm_ode_step_type *T, size_t dim, sicm_ode_rhs f
 void sicm_ode_free(sicm_ode *o) {
   if (!o) return;
   if (o->backend) o->type->free(o);
+  sicm_ode_free_events(o);
   free(o->y_last);
   free(o->stiffness_work);
   free(o->probe_work);
@@ -547,6 +549,11 @@ static int tiny_step(sicm_ode *o, double t, double h, double *y) {
 }
 
 int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y) {
+  o->stopping_event = -1;
+  return o->event_count ? sicm_ode_evolve_events(o, t, t1, y) : sicm_ode_evolve_plain(o, t, t1, y);
+}
+
+int sicm_ode_evolve_plain(sicm_ode *o, double *t, double t1, double *y) {
   if (!isfinite(*t) || !isfinite(t1)) {
     char detail[120];
     snprintf(detail, sizeof detail, "the end time t1 = %g is not finite", t1);

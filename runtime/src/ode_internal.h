@@ -82,6 +82,26 @@ struct sicm_ode {
   sicm_ode_taylor_extended_coefficients taylor_extended; /* the same in long double */
   const double *taylor_params;
 
+  /* sicm_ode_set_events (ode_events.c): the events and their handler; for
+   * each event the sign of g where it was last not 0 (0: not seen yet);
+   * where the last evolve ended (have_event_last), to tell a resumed
+   * integration from a new one; the event that stopped it (-1: none); the
+   * integrator that places events on the solution (made at the first
+   * event), and scratch. */
+  sicm_ode_event *events;
+  size_t event_count;
+  sicm_ode_event_handler event_handler;
+  void *event_data;
+  int *event_sign;
+  int have_event_last;
+  double event_t_last;
+  double *event_y_last;
+  long stopping_event;
+  double event_t0; /* the start of the step whose events are being placed */
+  sicm_ode *event_solver;
+  double *event_work;
+  sicm_ode_event_stats event_stats;
+
   int horizon_set; /* sicm_ode_set_horizon: where the caller is going */
   double horizon;
   unsigned long steps_since_check;
@@ -149,6 +169,13 @@ typedef struct {
  * implicit methods (msbdf, CVODE) are not watched. */
 int sicm_ode_watch_stiffness(sicm_ode *o, double t, const double *y, double h, double t1,
                              sicm_ode_stability stability);
+
+/* sicm_ode_evolve_plain is sicm_ode_evolve without events;
+ * sicm_ode_evolve_events (ode_events.c) is it with them, calling the plain
+ * one a step at a time. sicm_ode_free_events releases what the events own. */
+int sicm_ode_evolve_plain(sicm_ode *o, double *t, double t1, double *y);
+int sicm_ode_evolve_events(sicm_ode *o, double *t, double t1, double *y);
+void sicm_ode_free_events(sicm_ode *o);
 
 /* All components finite? */
 int sicm_ode_finite(size_t n, const double *v);

@@ -604,3 +604,45 @@ void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_cl
   close_integrator(&it);
   free(shown);
 }
+
+/* The event of crossings, and where its crossings go. */
+typedef struct {
+  sicm_closure event;
+  const sicm_site *site;
+  sicm_list *list;
+  long count, found;
+} crossing_sink;
+
+static double event_of(double t, const double *y, void *c) {
+  (void)t;
+  const crossing_sink *sink = c;
+  double out;
+  sink->event.fn(y, &out, sink->event.p);
+  return out;
+}
+
+static int push_crossing(size_t event, double t, const double *y, void *c) {
+  (void)event;
+  (void)t;
+  crossing_sink *sink = c;
+  sicm_list_push(sink->site, sink->list, y);
+  return sink->count > 0 && ++sink->found >= sink->count; /* non-zero: stop here */
+}
+
+void sicm_drive_crossings(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure event,
+                          int direction, long count, const double *y, double t_final,
+                          sicm_list *list) {
+  static const char who[] = "crossings";
+  double *state = malloc(ode->dim * sizeof *state);
+  if (!state) sicm_program_fail(site, who, "out of memory");
+  memcpy(state, y, ode->dim * sizeof *state);
+  integrator it;
+  open_integrator(site, who, ode, &it);
+  crossing_sink sink = {event, site, list, count, 0};
+  const sicm_ode_event e = {event_of, &sink, direction, 0};
+  if (sicm_ode_set_events(it.o, &e, 1, push_crossing, &sink)) fail_with_status(site, who);
+  double t = start_time(ode, state);
+  evolve_to(site, who, &it, &t, t_final, state);
+  close_integrator(&it);
+  free(state);
+}

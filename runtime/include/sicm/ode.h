@@ -227,6 +227,76 @@ int sicm_ode_set_max_steps(sicm_ode *o, unsigned long max_steps);
  * The same message goes to the error hook. */
 int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y);
 
+/* ---- events ----------------------------------------------------------
+ * An event is a real function g(t, y) of the solution; it happens where g
+ * changes sign along the solution, in a chosen direction: up (from
+ * negative to positive as the integration proceeds, whichever way t runs),
+ * down, or both. A g that touches 0 and turns back (a tangency) makes no
+ * event; a g that is 0 where an evolve starts makes none there either (it
+ * counts from the first point where g is not 0), so an integration resumed
+ * from an event's state does not find that event again.
+ *
+ * With events set, sicm_ode_evolve integrates step by step (its steps are
+ * those the method's controller chooses; for CVODE, the Taylor methods and
+ * the fixed-step methods, spans of the size a 4th-order method would take
+ * first), and after each step [ta, tb] it looks for sign changes of each g on
+ * a continuous extension of the step: the quintic Hermite interpolant of the
+ * states and derivatives at the step's start, middle and end (the middle
+ * state integrated from the start, which costs about a step more), sampled
+ * at SICM_ODE_EVENT_SAMPLES equal sub-intervals, so that two crossings in
+ * one step are both found. Each sign change is placed by Brent's method, first
+ * on the interpolant, then on the solution itself: each trial time is
+ * reached by integrating from the step's start with the same method and
+ * tolerances, so a located event is as accurate as the integration (the
+ * interpolant only brackets it), to a few ulps of the time since the
+ * step's start (the trial integrations run in that time, so the state at
+ * a crossing late in a long run is on it to the resolution of the step,
+ * not of t). Where the solution does not change sign as the interpolant
+ * does, the solution itself is sampled; if it does not change sign there
+ * either, there is no event (a graze of the interpolant's making).
+ *
+ * The located events of a step are handled in time order: the handler, if
+ * any, gets the event's index, time and state; it returns 0 to go on, or
+ * non-zero to stop there as a terminal event does. When an event stops the
+ * integration, sicm_ode_evolve returns SICM_SUCCESS with *t and y at the
+ * event (*t != t1 then) and sicm_ode_stopping_event says which.
+ *
+ * g returns its value; a NaN or infinity fails the evolve with
+ * SICM_EBADFUNC naming the event's index. */
+typedef double (*sicm_ode_event_function)(double t, const double *y, void *params);
+
+enum { SICM_ODE_EVENT_UP = 1, SICM_ODE_EVENT_DOWN = 2, SICM_ODE_EVENT_BOTH = 3 };
+enum { SICM_ODE_EVENT_SAMPLES = 8 };
+
+typedef struct {
+  sicm_ode_event_function g;
+  void *params;
+  int direction; /* SICM_ODE_EVENT_UP, _DOWN or _BOTH */
+  int terminal;  /* non-zero: the integration stops at the event */
+} sicm_ode_event;
+
+typedef int (*sicm_ode_event_handler)(size_t event, double t, const double *y, void *data);
+
+/* sicm_ode_set_events gives o its events (n of them; n = 0 removes them),
+ * copied, and the handler of located events (NULL: none) with its data.
+ * Returns SICM_SUCCESS, SICM_EINVAL (a NULL g, a bad direction) or
+ * SICM_ENOMEM. */
+int sicm_ode_set_events(sicm_ode *o, const sicm_ode_event *events, size_t n,
+                        sicm_ode_event_handler handler, void *data);
+
+/* sicm_ode_stopping_event returns the index of the event that stopped the
+ * last sicm_ode_evolve, or -1 if it ran to t1 (or failed). */
+long sicm_ode_stopping_event(const sicm_ode *o);
+
+/* sicm_ode_event_stats: events located since the object was made, and the
+ * trial times their placement on the solution cost (each an integration
+ * from a step's start). */
+typedef struct {
+  unsigned long located;
+  unsigned long iterations;
+} sicm_ode_event_stats;
+const sicm_ode_event_stats *sicm_ode_get_event_stats(const sicm_ode *o);
+
 /* sicm_ode_set_singularity_probe names the cause when an integration
  * fails at a singularity of its equations (a collision, coordinates that
  * are singular there). probe(y, values, params) computes n quantities the

@@ -288,6 +288,16 @@ void sicm_list_push(const sicm_site *site, sicm_list *list, const double *elemen
 void sicm_list_assign(const sicm_site *site, sicm_list *list, size_t width, const double *data,
                       size_t len);
 
+/* ((crossings ...) state event direction t-final tol [integrator [count]]):
+ * the states, from y (dim leaves) to t_final, at which event (a kernel of
+ * the state giving one number) crosses 0 in direction (SICM_ODE_EVENT_UP,
+ * _DOWN or _BOTH of sicm/ode.h), added in time order to list (which the
+ * caller has emptied for elements of dim doubles); the first count of them
+ * only, the integration stopping at the last, when count > 0. */
+void sicm_drive_crossings(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure event,
+                          int direction, long count, const double *y, double t_final,
+                          sicm_list *list);
+
 /* The number of elements added since the last reset. */
 double sicm_list_length(const sicm_list *list);
 
