@@ -464,6 +464,8 @@ struct OdeDeleter {
     if (sicm_stats_enabled() && seconds) {
       sicm_stats_add(loc_text(loc).c_str(), who, sicm_ode_name(o), tolerance, sicm_ode_get_stats(o),
                      *seconds);
+      sicm_stats_add_events(loc_text(loc).c_str(), who, sicm_ode_name(o), tolerance,
+                            sicm_ode_get_event_stats(o));
     }
     sicm_ode_free(o);
   }

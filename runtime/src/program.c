@@ -547,6 +547,8 @@ static void open_integrator(const sicm_site *site, const char *who, const sicm_d
 static void close_integrator(integrator *it) {
   sicm_stats_add(it->site->where, it->who, sicm_ode_name(it->o), it->tol, sicm_ode_get_stats(it->o),
                  it->seconds);
+  sicm_stats_add_events(it->site->where, it->who, sicm_ode_name(it->o), it->tol,
+                        sicm_ode_get_event_stats(it->o));
   sicm_ode_free(it->o);
   free(it->jac_out);
 }

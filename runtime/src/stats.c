@@ -17,6 +17,7 @@ typedef struct {
   unsigned long calls;
   sicm_ode_stats work;
   double seconds;
+  sicm_ode_event_stats events;
 } site_line;
 
 static int enabled;
@@ -52,7 +53,8 @@ static site_line *line_of(const char *where, const char *who, const char *method
     capacity = more;
   }
   site_line *l = &lines[nlines];
-  *l = (site_line){strdup(where), strdup(who), strdup(method), tolerance, 0, {0, 0, 0, 0}, 0};
+  *l = (site_line){strdup(where), strdup(who), strdup(method), tolerance, 0,
+                   {0, 0, 0, 0},  0,           {0, 0}};
   if (!l->where || !l->who || !l->method) {
     free(l->where), free(l->who), free(l->method);
     return NULL;
@@ -77,6 +79,18 @@ void sicm_stats_add(const char *where, const char *who, const char *method, doub
   pthread_mutex_unlock(&lock);
 }
 
+void sicm_stats_add_events(const char *where, const char *who, const char *method, double tolerance,
+                           const sicm_ode_event_stats *events) {
+  if (!enabled || !events || events->located == 0) return;
+  pthread_mutex_lock(&lock);
+  site_line *l = line_of(where ? where : "?", who ? who : "?", method ? method : "?", tolerance);
+  if (l) {
+    l->events.located += events->located;
+    l->events.iterations += events->iterations;
+  }
+  pthread_mutex_unlock(&lock);
+}
+
 /* A tolerance as people write one: 1e-12, 2.5e-13 (the shortest %g form
  * that reads back as x), not Scheme's .000000000001. */
 static void format_tolerance(char *buf, size_t size, double x) {
@@ -97,11 +111,15 @@ static void print_lines(FILE *f) {
     char rounded[32];
     snprintf(rounded, sizeof rounded, "%.3g", l->seconds);
     sicm_format_double(secs, strtod(rounded, NULL));
+    char events[96] = "";
+    if (l->events.located > 0)
+      snprintf(events, sizeof events, ", %lu event%s located (%lu placement integrations)",
+               l->events.located, l->events.located == 1 ? "" : "s", l->events.iterations);
     fprintf(f,
             "%s: %s, %s, tolerance %s: %lu call%s, %lu steps (%lu rejected), %lu rhs "
-            "evaluations, %s s\n",
+            "evaluations%s, %s s\n",
             l->where, l->who, l->method, tol, l->calls, l->calls == 1 ? "" : "s", l->work.steps,
-            l->work.rejected_steps, l->work.rhs_evals, secs);
+            l->work.rejected_steps, l->work.rhs_evals, events, secs);
   }
 }
 

@@ -31,17 +31,32 @@ TEST(Stats, OneLinePerSiteMethodAndTolerance) {
   sicm_stats_add("x.sicm:3:1", "evolve", "rk8pd", 1e-10, &b, 0.25);
   sicm_stats_add("x.sicm:3:1", "evolve", "bulirsch-stoer", 1e-10, &b, 0.125);
   sicm_stats_add("x.sicm:9:5", "state-advancer", "rk8pd", 1e-10, &b, 0.001);
-  EXPECT_EQ(
-      printed(),
-      "integration statistics (--stats), one line per site, method and tolerance:\n"
-      "x.sicm:3:1: evolve, rk8pd, tolerance 1e-10: 2 calls, 140 steps (6 rejected), 1800 rhs "
-      "evaluations, .75 s\n"
-      "x.sicm:3:1: evolve, bulirsch-stoer, tolerance 1e-10: 1 call, 40 steps (1 rejected), "
-      "500 "
-      "rhs evaluations, .125 s\n"
-      "x.sicm:9:5: state-advancer, rk8pd, tolerance 1e-10: 1 call, 40 steps (1 rejected), "
-      "500 "
-      "rhs evaluations, .001 s\n");
+  EXPECT_EQ(printed(),
+            "integration statistics (--stats), one line per site, method and tolerance:\n"
+            "x.sicm:3:1: evolve, rk8pd, tolerance 1e-10: 2 calls, 140 steps (6 rejected), 1800 rhs "
+            "evaluations, .75 s\n"
+            "x.sicm:3:1: evolve, bulirsch-stoer, tolerance 1e-10: 1 call, 40 steps (1 rejected), "
+            "500 "
+            "rhs evaluations, .125 s\n"
+            "x.sicm:9:5: state-advancer, rk8pd, tolerance 1e-10: 1 call, 40 steps (1 rejected), "
+            "500 "
+            "rhs evaluations, .001 s\n");
+
+  // The events a crossings call located, and what placing them cost.
+  const sicm_ode_event_stats events = {12, 340}, none = {0, 0};
+  sicm_stats_add("x.sicm:12:1", "crossings", "rk8pd", 1e-12, &a, 0.5);
+  sicm_stats_add_events("x.sicm:12:1", "crossings", "rk8pd", 1e-12, &events);
+  sicm_stats_add_events("x.sicm:9:5", "state-advancer", "rk8pd", 1e-10, &none);
+  const std::string all = printed();
+  EXPECT_NE(all.find("x.sicm:12:1: crossings, rk8pd, tolerance 1e-12: 1 call, 100 steps (5 "
+                     "rejected), 1300 rhs evaluations, 12 events located (340 placement "
+                     "integrations), .5 s\n"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("x.sicm:9:5: state-advancer, rk8pd, tolerance 1e-10: 1 call, 40 steps (1 "
+                     "rejected), 500 rhs evaluations, .001 s\n"),
+            std::string::npos)
+      << all;
 }
 
 } // namespace

@@ -28,9 +28,17 @@ double sicm_stats_clock(void);
 void sicm_stats_add(const char *where, const char *who, const char *method, double tolerance,
                     const sicm_ode_stats *work, double seconds);
 
+/* sicm_stats_add_events adds to the same line the events one integration
+ * located (crossings) and the trial integrations their placement on the
+ * solution cost; a line that has any says so. */
+void sicm_stats_add_events(const char *where, const char *who, const char *method,
+                           double tolerance, const sicm_ode_event_stats *events);
+
 /* sicm_stats_print writes a header and one line per site to f, as
  *   FILE:LINE:COL: evolve, bulirsch-stoer, tolerance 1e-13: 2 calls, 1234 steps
  *   (56 rejected), 45678 rhs evaluations, .0123 s
+ * and, where events were located, ", 12 events located (340 placement
+ * integrations)" after the rhs evaluations
  * (on one line; numbers as the compiler prints them); nothing if no
  * integration was recorded. */
 void sicm_stats_print(FILE *f);
