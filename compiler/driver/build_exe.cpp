@@ -12,10 +12,12 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <vector>
 
 #include "base/error.hpp"
+#include "base/temporary_files.hpp"
 #include "codegen/jit.hpp"
 
 extern char **environ;
@@ -118,18 +120,22 @@ int compile_executable(const std::string &c, const BuildOptions &o) {
   }
   std::string c_path = o.output + ".c";
   bool keep = o.keep_c;
-  if (!keep) {
-    char tmpl[] = "/tmp/sicm-build-XXXXXX";
-    int fd = mkstemp(tmpl);
+  if (!keep) { // $TMPDIR/sicm-build-XXXXXX.c, made here so no other can take the name
+    std::string pattern = temporary_directory() + "/sicm-build-XXXXXX.c";
+    std::vector<char> name(pattern.begin(), pattern.end());
+    name.push_back('\0');
+    int fd = mkstemps(name.data(), 2);
     if (fd < 0) {
-      std::fprintf(stderr, "sicm: error: cannot create a temporary file: %s\n",
-                   std::strerror(errno));
+      std::fprintf(stderr, "sicm: error: cannot create a temporary file in %s: %s\n",
+                   temporary_directory().c_str(), std::strerror(errno));
       return kExitCantCreat;
     }
     close(fd);
-    std::remove(tmpl);
-    c_path = std::string(tmpl) + ".c";
+    c_path = name.data();
   }
+  // Interrupted or killed (but by SIGKILL) from here on, the C goes too.
+  std::optional<RemovedIfInterrupted> removed_if_interrupted;
+  if (!keep) removed_if_interrupted.emplace(c_path);
   {
     std::ofstream out(c_path, std::ios::binary);
     out << c;

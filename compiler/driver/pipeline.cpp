@@ -45,6 +45,7 @@
 #include <vector>
 
 #include "base/srcloc.hpp"
+#include "base/temporary_files.hpp"
 #include "builtins/effects_used.hpp"
 #include "builtins/parameter.hpp"
 #include "builtins/plot.hpp"
@@ -123,8 +124,7 @@ int run_program(const std::string &path) {
 }
 
 int run_quietly(const std::string &path) {
-  const char *tmp = std::getenv("TMPDIR");
-  std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/sicm-emit-XXXXXX";
+  std::string pattern = temporary_directory() + "/sicm-emit-XXXXXX";
   std::vector<char> dir(pattern.begin(), pattern.end());
   dir.push_back('\0');
   bool have_dir = mkdtemp(dir.data()) != nullptr;

@@ -12,6 +12,9 @@
 #include <cstdlib>
 #include <string>
 #include <thread>
+#include <vector>
+
+#include "base/temporary_files.hpp"
 
 namespace sicm {
 
@@ -26,9 +29,11 @@ std::string format_seconds(double s) {
 } // namespace
 
 std::string what_sicm_run_does(const std::string &file, double seconds) {
-  char dir_template[] = "/tmp/sicm-run-check-XXXXXX";
-  if (!mkdtemp(dir_template)) return "";
-  const std::string plots = dir_template;
+  std::string pattern = temporary_directory() + "/sicm-run-check-XXXXXX";
+  std::vector<char> dir_template(pattern.begin(), pattern.end());
+  dir_template.push_back('\0');
+  if (!mkdtemp(dir_template.data())) return "";
+  const std::string plots = dir_template.data();
   int err_pipe[2];
   if (pipe(err_pipe) != 0) {
     rmdir(plots.c_str());

@@ -5,6 +5,11 @@
 
 #include "sicm_command.hpp"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -67,4 +72,48 @@ TEST(BuildOutput, TheRefusalSaysWhatSicmRunDoes) {
                        "the correct type."),
             std::string::npos)
       << fails;
+}
+
+// A build killed while the C compiler runs leaves no C behind in $TMPDIR
+// (base/temporary_files.hpp).
+TEST(BuildOutput, AKilledBuildLeavesNoCBehind) {
+  if (!fs::exists(sicm_path())) GTEST_SKIP() << "no sicm binary at " << sicm_path();
+  char tmpl[] = "/tmp/sicm-build-killed-XXXXXX";
+  ASSERT_NE(mkdtemp(tmpl), nullptr);
+  const fs::path dir = tmpl, tmpdir = dir / "tmp";
+  fs::create_directory(tmpdir);
+  std::ofstream(dir / "p.sicm")
+      << "(define ((spring k) s) (up 1 (ref s 2) (- (* k (sin (ref s 1))))))\n"
+         "(display ((state-advancer spring 1.3) (up 0. 1. 0.) 10. 1e-12))\n";
+  const std::string program = (dir / "p.sicm").string(), out = (dir / "p").string();
+  const std::string env = "TMPDIR=" + tmpdir.string();
+  pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    putenv(const_cast<char *>(env.c_str()));
+    int null = open("/dev/null", O_WRONLY);
+    dup2(null, 1);
+    dup2(null, 2);
+    execl(sicm_path().c_str(), "sicm", "build", program.c_str(), "-o", out.c_str(),
+          static_cast<char *>(nullptr));
+    _exit(127);
+  }
+  // Wait for the C to be written (then the removal is armed), and kill.
+  bool seen = false;
+  for (int i = 0; i < 6000 && !seen; ++i) {
+    for (const auto &entry : fs::directory_iterator(tmpdir))
+      if (entry.path().extension() == ".c" && fs::file_size(entry.path()) > 0) seen = true;
+    if (!seen) usleep(5000);
+  }
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(seen) << "the build's C never appeared in " << tmpdir;
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM);
+  size_t left = 0;
+  for (const auto &entry : fs::directory_iterator(tmpdir))
+    left += entry.path().extension() == ".c";
+  EXPECT_EQ(left, 0u);
+  std::error_code ignored;
+  fs::remove_all(dir, ignored);
 }
