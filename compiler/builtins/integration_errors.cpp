@@ -2,11 +2,10 @@
 // integration_errors.hpp).
 #include "builtins/integration_errors.hpp"
 
-#include <cstdio>
-#include <cstdlib>
-
+#include "builtins/numerics_defaults.hpp"
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
+#include "sicm/runtime.h"
 
 namespace sicm {
 
@@ -16,24 +15,9 @@ void derivative_shape_error(SrcLoc loc, const char *who, Value derivative, Value
                          "; it must be a structure of real numbers of the state's shape");
 }
 
-namespace {
-// A tolerance as people write one: 1e-17, 2.5e-13 (the shortest %g form
-// that reads back as x), not Scheme's .00000000000000001.
-std::string tolerance_text(double x) {
-  char buf[32];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
-} // namespace
-
 void check_reachable_tolerance(SrcLoc loc, const char *who, const sicm_ode_step_type *T,
                                double eps) {
-  if (!T || T == sicm_ode_step_verlet || T == sicm_ode_step_yoshida4 ||
-      T == sicm_ode_step_yoshida6 || T == sicm_ode_step_yoshida8)
-    return;
+  if (!T || integrator_is_fixed_step(T)) return;
   // Each step rounds the state to the working precision: unit roundoff
   // 1.1e-16 in double, 5.4e-20 in long double. A relative error below about
   // that is out of reach, whatever the step size (tests/numerics/
@@ -42,8 +26,10 @@ void check_reachable_tolerance(SrcLoc loc, const char *who, const sicm_ode_step_
   const double reachable = extended ? 1e-20 : 1e-16;
   if (eps >= reachable) return;
   std::string method = sicm_ode_step_type_name(T);
-  std::string what = std::string(who) + ": a tolerance of " + tolerance_text(eps) +
-                     " is below what " + method + " can reach: " +
+  char tolerance[SICM_DOUBLE_BUFSIZE];
+  sicm_format_tolerance(tolerance, eps);
+  std::string what = std::string(who) + ": a tolerance of " + tolerance + " is below what " +
+                     method + " can reach: " +
                      (extended ? "about 1e-20 relative in long double"
                                : "about 1e-16 relative in double precision") +
                      "; ";

@@ -476,71 +476,10 @@ using OdePtr = std::unique_ptr<sicm_ode, OdeDeleter>;
 
 Symbol *g_method_variable = nullptr; // *ode-integration-method*
 
-struct IntegratorName {
-  const char *name;
-  const sicm_ode_step_type *const *type;
-  const char *c_name;
-};
-const IntegratorName kIntegrators[] = {
-    {"bulirsch-stoer", &sicm_ode_step_bs, "sicm_ode_step_bs"},
-    {"bs", &sicm_ode_step_bs, "sicm_ode_step_bs"},
-    {"rk8pd", &sicm_ode_step_rk8pd, "sicm_ode_step_rk8pd"},
-    {"rkf45", &sicm_ode_step_rkf45, "sicm_ode_step_rkf45"},
-    {"rkck", &sicm_ode_step_rkck, "sicm_ode_step_rkck"},
-    // scmutils' quality-controlled RK4 and trapezoid rule (step doubling).
-    {"qcrk4", &sicm_ode_step_qcrk4, "sicm_ode_step_qcrk4"},
-    {"qcctrap2", &sicm_ode_step_qcctrap2, "sicm_ode_step_qcctrap2"},
-    {"msbdf", &sicm_ode_step_msbdf, "sicm_ode_step_msbdf"},
-    // scmutils' gear and explicit-gear are one method, Gear's: variable-order
-    // BDF with Newton iteration on the Jacobian ("explicit" is the system
-    // given as y' = f(y), against its implicit-gear). GSL's msbdf is an
-    // implementation of that method (orders 1-5 where scmutils has 1-4).
-    {"gear", &sicm_ode_step_msbdf, "sicm_ode_step_msbdf"},
-    {"explicit-gear", &sicm_ode_step_msbdf, "sicm_ode_step_msbdf"},
-    {"cvode-adams", &sicm_ode_step_cvode_adams, "sicm_ode_step_cvode_adams"},
-    {"cvode-bdf", &sicm_ode_step_cvode_bdf, "sicm_ode_step_cvode_bdf"},
-    // Fixed-step symplectic methods: the tolerance argument is the step size.
-    {"verlet", &sicm_ode_step_verlet, "sicm_ode_step_verlet"},
-    {"yoshida4", &sicm_ode_step_yoshida4, "sicm_ode_step_yoshida4"},
-    {"yoshida6", &sicm_ode_step_yoshida6, "sicm_ode_step_yoshida6"},
-    {"yoshida8", &sicm_ode_step_yoshida8, "sicm_ode_step_yoshida8"},
-    // Taylor series from coefficients generated from the compiled derivative.
-    {"taylor", &sicm_ode_step_taylor, "sicm_ode_step_taylor"},
-    {"taylor-extended", &sicm_ode_step_taylor_extended, "sicm_ode_step_taylor_extended"},
-};
-
-const IntegratorName *find_integrator(const std::string &name) {
-  for (const IntegratorName &i : kIntegrators)
-    if (name == i.name) return &i;
-  return nullptr;
-}
-
-// Integrators of scmutils that sicm does not provide, and what to use
-// instead: naming one is an error that says so, never a substitution.
-struct MissingIntegrator {
-  const char *name;
-  const char *instead;
-};
-const MissingIntegrator kNotProvided[] = {
-    {"implicit-gear", "it takes a system given implicitly, by a corrector; for stiff systems "
-                      "use gear (Gear's BDF method, GSL's msbdf) or cvode-bdf"},
-    {"ntqc", "it is the trapezoid rule with Newton iteration; use qcctrap2 (the same rule with "
-             "corrector iteration) or, for stiff systems, cvode-bdf"},
-};
-
 // Fails, saying so, if name is an integrator sicm does not provide.
 void check_provided(const std::string &name, const char *who) {
   std::string why = integrator_not_provided(name);
   if (!why.empty()) runtime_error(current_call_loc(), std::string(who) + ": " + why);
-}
-
-const char *const kIntegratorList =
-    "bulirsch-stoer, rk8pd, rkf45, rkck, qcrk4, qcctrap2, msbdf, gear, explicit-gear, "
-    "cvode-adams, cvode-bdf, verlet, yoshida4, yoshida6, yoshida8, taylor, taylor-extended";
-
-const sicm_ode_step_type *integrator_for(const std::string &name) {
-  const IntegratorName *i = find_integrator(name);
-  return i ? *i->type : nullptr;
 }
 
 // The integrator named by argument i, or by *ode-integration-method* when
@@ -548,15 +487,15 @@ const sicm_ode_step_type *integrator_for(const std::string &name) {
 const sicm_ode_step_type *arg_integrator(Value *a, int n, int i, const char *who) {
   if (is_missing(a, n, i)) {
     Value m = g_method_variable->bound ? g_method_variable->global : Value::unspecified();
-    const sicm_ode_step_type *T = is_symbol(m) ? integrator_for(symbol_name(m)) : nullptr;
+    const sicm_ode_step_type *T = is_symbol(m) ? integrator_named(symbol_name(m)) : nullptr;
     if (!T && is_symbol(m)) check_provided(symbol_name(m), who);
     if (!T)
       runtime_error(current_call_loc(), std::string(who) + ": *ode-integration-method* is " +
                                             write_string(m) + ", which names no integrator (" +
-                                            kIntegratorList + ")");
+                                            integrator_list() + ")");
     return T;
   }
-  return integrator_for(symbol_name(a[i])); // a name checked by check_numeric_arguments
+  return integrator_named(symbol_name(a[i])); // a name checked by check_numeric_arguments
 }
 
 // ---- one integration problem ----------------------------------------------------
@@ -1152,32 +1091,6 @@ Value P_eigenvalues(Value *a, int) {
 }
 
 } // namespace
-
-std::string integrator_not_provided(const std::string &name) {
-  for (const MissingIntegrator &m : kNotProvided)
-    if (name == m.name)
-      return "sicm does not provide the integrator " + name + " of scmutils: " + m.instead;
-  return "";
-}
-
-const char *integrator_list() {
-  return kIntegratorList;
-}
-
-const char *integrator_c_name(const std::string &name) {
-  const IntegratorName *i = find_integrator(name);
-  return i ? i->c_name : nullptr;
-}
-
-const sicm_ode_step_type *integrator_of_c_name(const std::string &c_name) {
-  for (const IntegratorName &i : kIntegrators)
-    if (c_name == i.c_name) return *i.type;
-  return nullptr;
-}
-
-const sicm_ode_step_type *integrator_named(const std::string &name) {
-  return integrator_for(name);
-}
 
 void install_numerics_primitives() {
   g_method_variable = intern("*ode-integration-method*").symbol();

@@ -29,6 +29,10 @@ const sicm_ode_step_type *integrator_named(const std::string &name);
 // answer), or null.
 const sicm_ode_step_type *integrator_of_c_name(const std::string &c_name);
 
+// The fixed-step symplectic methods (verlet, yoshida4/6/8), whose tolerance
+// argument is their step size.
+bool integrator_is_fixed_step(const sicm_ode_step_type *T);
+
 // The integrators' names, for messages ("bulirsch-stoer, rk8pd, ...").
 const char *integrator_list();
 

@@ -260,3 +260,12 @@ size_t sicm_format_double(char *buf, double x) {
   buf[at] = '\0';
   return at;
 }
+
+size_t sicm_format_tolerance(char *buf, double x) {
+  int len = 0;
+  for (int digits = 1; digits <= 17; digits++) {
+    len = snprintf(buf, SICM_DOUBLE_BUFSIZE, "%.*g", digits, x);
+    if (strtod(buf, NULL) == x) break;
+  }
+  return len < 0 ? 0 : (size_t)len;
+}

@@ -91,22 +91,13 @@ void sicm_stats_add_events(const char *where, const char *who, const char *metho
   pthread_mutex_unlock(&lock);
 }
 
-/* A tolerance as people write one: 1e-12, 2.5e-13 (the shortest %g form
- * that reads back as x), not Scheme's .000000000001. */
-static void format_tolerance(char *buf, size_t size, double x) {
-  for (int digits = 1; digits <= 17; digits++) {
-    snprintf(buf, size, "%.*g", digits, x);
-    if (strtod(buf, NULL) == x) return;
-  }
-}
-
 static void print_lines(FILE *f) {
   if (nlines == 0) return;
   fputs("integration statistics (--stats), one line per site, method and tolerance:\n", f);
   for (size_t i = 0; i < nlines; i++) {
     const site_line *l = &lines[i];
-    char tol[32], secs[SICM_DOUBLE_BUFSIZE];
-    format_tolerance(tol, sizeof tol, l->tolerance);
+    char tol[SICM_DOUBLE_BUFSIZE], secs[SICM_DOUBLE_BUFSIZE];
+    sicm_format_tolerance(tol, l->tolerance);
     /* Seconds to 3 significant digits: the clock is not more repeatable. */
     char rounded[32];
     snprintf(rounded, sizeof rounded, "%.3g", l->seconds);

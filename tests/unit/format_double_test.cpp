@@ -211,3 +211,17 @@ TEST(FormatDouble, RandomRoundTripAndMinimal) {
 }
 
 } // namespace
+
+// Tolerances as people write them, for messages and --stats.
+TEST(FormatTolerance, ShortestGFormThatReadsBack) {
+  auto tol = [](double x) {
+    char buf[SICM_DOUBLE_BUFSIZE];
+    size_t n = sicm_format_tolerance(buf, x);
+    return std::string(buf, n);
+  };
+  EXPECT_EQ(tol(1e-12), "1e-12");
+  EXPECT_EQ(tol(2.5e-13), "2.5e-13");
+  EXPECT_EQ(tol(0.01), "0.01");
+  EXPECT_EQ(tol(1e-17), "1e-17");
+  EXPECT_EQ(tol(0.1 + 0.2), "0.30000000000000004");
+}

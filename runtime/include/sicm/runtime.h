@@ -37,6 +37,12 @@ extern "C" {
 #define SICM_DOUBLE_BUFSIZE 40
 size_t sicm_format_double(char *buf, double x);
 
+/* sicm_format_tolerance writes x as people write a tolerance: the shortest
+ * %g form that reads back as x ("1e-12", "2.5e-13", "0.01"), not Scheme's
+ * ".000000000001" (messages and --stats). buf must hold at least
+ * SICM_DOUBLE_BUFSIZE bytes. Returns the length written. */
+size_t sicm_format_tolerance(char *buf, double x);
+
 /* sicm_shortest_digits stores in digits (>= 18 bytes) the shortest decimal
  * digit string d1 d2 ... dn (no sign, no point, no trailing zeros) such that
  * 0.d1d2...dn * 10^(*exponent10 + 1) read back gives |x|, i.e. |x| is
