@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <thread>
 #include <vector>
@@ -84,9 +85,8 @@ std::string what_sicm_run_does(const std::string &file, double seconds) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   close(err_pipe[0]);
-  std::string remove = "rm -rf '" + plots + "'";
-  if (std::system(remove.c_str()) != 0) { /* a temporary directory left behind */
-  }
+  std::error_code ignored;
+  std::filesystem::remove_all(plots, ignored);
   if (!finished)
     return "`sicm run` ran it for " + format_seconds(seconds) +
            " s without failing (stopped there)";
