@@ -2,6 +2,7 @@
 // (see compiled_procedures.hpp).
 #include "builtins/compiled_procedures.hpp"
 
+#include <cstdint>
 #include <string>
 
 #include "base/error.hpp"
@@ -34,8 +35,24 @@ constexpr size_t kCompiledMemo = 32;
 // that differ in structure load another shared object, and the JIT bounds
 // those (--max-compiled-kernels, base/limits.hpp).
 
+// Recent event procedures of crossings, with their interpreted calls.
+struct CompiledEvent {
+  Value event;
+  Value state_shape; // a sample state
+  uint64_t interpreted = 0;
+  bool tried = false;
+  CompiledFn compiled = nullptr;
+};
+gcvec<CompiledEvent> g_events; // static, hence a root for the collector
+// An interpreted event costs some hundreds of nanoseconds, its compiled
+// function a few; the C compiler, once, a tenth of a second or less (the
+// JIT keeps what it has compiled). A section of one long orbit evaluates
+// the event about ten times a step, a million times over 10^4 time units.
+constexpr uint64_t kCompileEventAfter = 20000;
+
 ScalarCompiler g_scalar_compiler = nullptr;
 SystemCompiler g_system_compiler = nullptr;
+SystemCompiler g_event_compiler = nullptr;
 
 // Under SICM_INTERPRET=1 there is no C compiler: kernels are still made,
 // and run by the kernel interpreter (compile_kernel), but what only the
@@ -85,6 +102,25 @@ const Kernel *jacobian_kernel(Value sysder, Value state, size_t dim) {
   }
 }
 
+CompiledFn compiled_event(Value event, Value state, int counts, const char *who) {
+  CompiledEvent *entry = nullptr;
+  for (CompiledEvent &e : g_events)
+    if (eq(e.event, event) && value_has_shape(state, e.state_shape)) entry = &e;
+  if (!entry) {
+    if (g_events.size() >= kCompiledMemo) g_events.erase(g_events.begin());
+    g_events.push_back(CompiledEvent{event, state});
+    entry = &g_events.back();
+  }
+  entry->interpreted += static_cast<uint64_t>(counts);
+  if (!entry->tried && entry->interpreted >= kCompileEventAfter && c_compiler_enabled() &&
+      g_event_compiler) {
+    entry->tried = true;
+    std::string why;
+    entry->compiled = g_event_compiler(event, state, who, &why);
+  }
+  return entry->compiled;
+}
+
 CompiledFn compile_expensive_function(Value f, const char *who) {
   if (!c_compiler_enabled() || !g_scalar_compiler) return nullptr;
   std::string why_not;
@@ -97,6 +133,10 @@ void set_scalar_compiler(ScalarCompiler compiler) {
 
 void set_system_compiler(SystemCompiler compiler) {
   g_system_compiler = compiler;
+}
+
+void set_event_compiler(SystemCompiler compiler) {
+  g_event_compiler = compiler;
 }
 
 } // namespace sicm

@@ -32,6 +32,15 @@ CompiledFn auto_residual(Value sysder, Value state, const char *who);
 // derivative cannot be differentiated and traced, or no C compiler).
 const Kernel *jacobian_kernel(Value sysder, Value state, size_t dim);
 
+// crossings' event procedure on states shaped like `state`, compiled by
+// the partial evaluator once it has been interpreted often enough to pay
+// for the C compiler (kCompileEventAfter calls, counted across the calls of
+// crossings with the same procedure: a section map calls crossings once
+// per point). Call it after each interpreted call (counts == 1) or to ask
+// for what is compiled already (counts == 0); null until then, and when the
+// procedure cannot be compiled (then it is not tried again).
+CompiledFn compiled_event(Value event, Value state, int counts, const char *who);
+
 // bisect's function f, whose interpreted calls prove expensive, compiled
 // by the partial evaluator; null when it cannot be.
 CompiledFn compile_expensive_function(Value f, const char *who);

@@ -745,23 +745,34 @@ Value P_evolve(Value *a, int n) {
 // ---- crossings ----------------------------------------------------------------------
 
 // The event procedure of crossings: a real function of the state, computed
-// by the interpreter (flonums stay flonums, as sicm build's residual
-// function of it computes), and the states at the crossings found.
+// by the interpreter (flonums stay flonums), then, once it has been called
+// often enough, by the function sicm build's partial evaluator makes of it
+// (compiled_event), which computes as the interpreter does and as the
+// built program's does: the same numbers either way. And the states at the
+// crossings found.
 struct EventCallback : Callback {
   Value event;
   const StateShape *shape;
+  Value sample; // a state of that shape, for compiled_event
+  CompiledFn compiled = nullptr;
   gcvec<Value> found;
   size_t most = 0; // stop after this many crossings (0: no limit)
-  EventCallback(SrcLoc l, const char *w, Value e, const StateShape *s)
-      : Callback(l, w), event(e), shape(s) {}
+  EventCallback(SrcLoc l, const char *w, Value e, const StateShape *s, Value state)
+      : Callback(l, w), event(e), shape(s), sample(state) {
+    compiled = compiled_event(event, sample, 0, who);
+  }
 };
 
 double call_event(double, const double *y, void *data) {
   auto *cb = static_cast<EventCallback *>(data);
   if (cb->error) return NAN;
+  double value;
+  // A compiled event gives up (1) where the interpreter must compute.
+  if (cb->compiled && cb->compiled(y, &value, interrupt_flag()) == 0) return value;
   try {
     Value state = cb->shape->build(y);
     Value g = apply_procedure(cb->event, &state, 1);
+    if (!cb->compiled) cb->compiled = compiled_event(cb->event, cb->sample, 1, cb->who);
     if (!is_number(g) || !is_real(g))
       runtime_error(cb->loc, std::string(cb->who) + ": the event procedure returned " +
                                  write_string(g) + " for the state " + write_string(state) +
@@ -805,7 +816,7 @@ Value run_crossings(NativeProc *self, Value *a, int n) {
   check_reachable_tolerance(loc, who, T, eps);
   OdeProblem p(loc, who, self->a, a[0], 1,
                T == sicm_ode_step_taylor || T == sicm_ode_step_taylor_extended);
-  EventCallback events(loc, who, a[1], &p.shape);
+  EventCallback events(loc, who, a[1], &p.shape, a[0]);
   events.most = is_missing(a, n, 6) ? 0 : static_cast<size_t>(a[6].i);
   {
     RuntimeErrorScope scope;

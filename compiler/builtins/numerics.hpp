@@ -33,6 +33,12 @@ using SystemCompiler = CompiledFn (*)(Value sysder, Value state, const char *who
                                       std::string *why_not);
 void set_system_compiler(SystemCompiler compiler);
 
+// What compiles the event procedure of crossings, once its interpreted
+// calls prove many, for states shaped like `state` (the same signature: the
+// output is the event's one value). pe/for_run.cpp's compile_event_for_run,
+// given at start-up; without one, the event is interpreted.
+void set_event_compiler(SystemCompiler compiler);
+
 struct NativeProc;
 
 // The call of the procedure (crossings sysder . params) returns, self being

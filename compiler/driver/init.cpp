@@ -43,6 +43,7 @@ void init_interpreter() {
   set_expression_node_counter(expr_count);
   set_scalar_compiler(compile_for_run);
   set_system_compiler(compile_system_for_run);
+  set_event_compiler(compile_event_for_run);
   install_special_forms();
   install_core_primitives();
   install_list_primitives();

@@ -59,4 +59,10 @@ CompiledFn compile_for_run(Value f, const char *who, std::string *why_not);
 // compile_for_run. Given at start-up (set_system_compiler).
 CompiledFn compile_system_for_run(Value sysder, Value state, const char *who, std::string *why_not);
 
+// sicm run: the event procedure of crossings (a real function of states
+// shaped like `state`) compiled by the partial evaluator, as sicm build
+// compiles it (one output, the event's value). Null with the reason in
+// *why_not when it cannot be. Given at start-up (set_event_compiler).
+CompiledFn compile_event_for_run(Value event, Value state, const char *who, std::string *why_not);
+
 } // namespace sicm

@@ -1,5 +1,6 @@
 // sicm run's compiled procedures: a procedure of one real (bisect's
-// function), or a system derivative that tests the state, compiled by sicm
+// function), a system derivative that tests the state, or the event of
+// crossings (a real function of the state), compiled by sicm
 // build's partial evaluator into a C function, as a built program compiles
 // it, and loaded into the running process.
 //
@@ -13,7 +14,8 @@
 // How: build mode is switched on for the trace alone (begin_build_mode ...
 // end_build_mode) with a residual program of its own; the procedure is
 // traced into one function exactly as sicm build traces bisect's function
-// (trace_scalar) or a system derivative (trace_system_function); the
+// (trace_scalar), a system derivative (trace_system_function) or an event
+// (trace_event_function); the
 // function is written as a C unit that needs no runtime
 // (emit_residual_function) and loaded by the JIT.
 //
@@ -233,6 +235,11 @@ CompiledFn compile_system_for_run(Value sysder, Value state, const char *who,
                                   std::string *why_not) {
   return compile_traced_for_run(
       sysder, [&] { return build::trace_system_function(sysder, state, who); }, why_not);
+}
+
+CompiledFn compile_event_for_run(Value event, Value state, const char *who, std::string *why_not) {
+  return compile_traced_for_run(
+      event, [&] { return build::trace_event_function(event, state, who); }, why_not);
 }
 
 } // namespace sicm

@@ -639,6 +639,22 @@ int trace_system_function(Value sysder, Value state, const char *who) {
   }
 }
 
+// An event traced into a new function of the state's leaves with one
+// output, the event's value, computing as the interpreter computes (the
+// event is interpreted in sicm run until it proves worth compiling, and
+// then compiled from this same trace: pe/for_run.cpp). Returns its id.
+int trace_event_function(Value event, Value state, const char *who) {
+  SrcLoc call = here();
+  FunctionScope scope(procedure_name(event));
+  Value x = input_like(state);
+  Value g = apply_procedure(event, &x, 1);
+  if (!is_number(g) && !is_dynamic_scalar(g))
+    cannot_compile(call, std::string(who) + ": the event procedure returns " + describe(g) +
+                             ", not a number");
+  current().outputs.push_back(expr_of(g, who));
+  return scope.id();
+}
+
 namespace {
 
 // Trace a system derivative on a state shaped like `state`; fills the
@@ -880,18 +896,7 @@ Value crossings_in_build(NativeProc *self, Value *a, int n) {
   check_taylor(s, who);
   trace_singular_factors(a[0], s);
   trace_jacobian(self->a, a[0], s);
-  {
-    // The event, a function of the state computing as the interpreter
-    // computes, as sicm run interprets it.
-    FunctionScope scope(procedure_name(a[1]));
-    Value x = input_like(a[0]);
-    Value g = apply_procedure(a[1], &x, 1);
-    if (!is_number(g) && !is_dynamic_scalar(g))
-      cannot_compile(s.loc, std::string(who) + ": the event procedure returns " + describe(g) +
-                                ", not a number");
-    current().outputs.push_back(expr_of(g, who));
-    s.monitor = scope.id();
-  }
+  s.monitor = trace_event_function(a[1], a[0], who);
   gcvec<Value> leaves;
   state_leaves(a[0], leaves);
   s.list = new_list(inexact_leaves(a[0]), std::vector<RType>(leaves.size(), RType::Real), who);

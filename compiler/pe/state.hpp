@@ -256,6 +256,9 @@ int trace_scalar(Value f, const char *who);
 // Trace a system derivative into a new function from the leaves of a state
 // shaped like `state` to the leaves of its derivative; returns its id.
 int trace_system_function(Value sysder, Value state, const char *who);
+// Trace an event (a real function of a state shaped like `state`) into a
+// new function from the state's leaves to its one value; returns its id.
+int trace_event_function(Value event, Value state, const char *who);
 // A value shaped like `sample` (a number, or an up/down structure of them)
 // whose leaves are fresh inputs of the open function.
 Value input_like(Value sample);
