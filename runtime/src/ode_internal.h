@@ -93,6 +93,7 @@ struct sicm_ode {
   sicm_ode_event_handler event_handler;
   void *event_data;
   int *event_sign;
+  int *event_sign_scratch; /* the signs a screened step ends with, before they are taken */
   int have_event_last;
   double event_t_last;
   double *event_y_last;

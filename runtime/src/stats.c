@@ -54,7 +54,7 @@ static site_line *line_of(const char *where, const char *who, const char *method
   }
   site_line *l = &lines[nlines];
   *l = (site_line){strdup(where), strdup(who), strdup(method), tolerance, 0,
-                   {0, 0, 0, 0},  0,           {0, 0}};
+                   {0, 0, 0, 0},  0,           {0, 0, 0}};
   if (!l->where || !l->who || !l->method) {
     free(l->where), free(l->who), free(l->method);
     return NULL;
@@ -87,6 +87,7 @@ void sicm_stats_add_events(const char *where, const char *who, const char *metho
   if (l) {
     l->events.located += events->located;
     l->events.iterations += events->iterations;
+    l->events.screened += events->screened;
   }
   pthread_mutex_unlock(&lock);
 }
@@ -102,10 +103,13 @@ static void print_lines(FILE *f) {
     char rounded[32];
     snprintf(rounded, sizeof rounded, "%.3g", l->seconds);
     sicm_format_double(secs, strtod(rounded, NULL));
-    char events[96] = "";
+    char events[160] = "";
     if (l->events.located > 0)
-      snprintf(events, sizeof events, ", %lu event%s located (%lu placement integrations)",
-               l->events.located, l->events.located == 1 ? "" : "s", l->events.iterations);
+      snprintf(events, sizeof events,
+               ", %lu event%s located (%lu placement integrations; %lu steps screened free of "
+               "events)",
+               l->events.located, l->events.located == 1 ? "" : "s", l->events.iterations,
+               l->events.screened);
     fprintf(f,
             "%s: %s, %s, tolerance %s: %lu call%s, %lu steps (%lu rejected), %lu rhs "
             "evaluations%s, %s s\n",

@@ -43,14 +43,14 @@ TEST(Stats, OneLinePerSiteMethodAndTolerance) {
             "rhs evaluations, .001 s\n");
 
   // The events a crossings call located, and what placing them cost.
-  const sicm_ode_event_stats events = {12, 340}, none = {0, 0};
+  const sicm_ode_event_stats events = {12, 340, 95}, none = {0, 0, 0};
   sicm_stats_add("x.sicm:12:1", "crossings", "rk8pd", 1e-12, &a, 0.5);
   sicm_stats_add_events("x.sicm:12:1", "crossings", "rk8pd", 1e-12, &events);
   sicm_stats_add_events("x.sicm:9:5", "state-advancer", "rk8pd", 1e-10, &none);
   const std::string all = printed();
   EXPECT_NE(all.find("x.sicm:12:1: crossings, rk8pd, tolerance 1e-12: 1 call, 100 steps (5 "
                      "rejected), 1300 rhs evaluations, 12 events located (340 placement "
-                     "integrations), .5 s\n"),
+                     "integrations; 95 steps screened free of events), .5 s\n"),
             std::string::npos)
       << all;
   EXPECT_NE(all.find("x.sicm:9:5: state-advancer, rk8pd, tolerance 1e-10: 1 call, 40 steps (1 "

@@ -240,13 +240,18 @@ int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y);
  * those the method's controller chooses; for CVODE, the Taylor methods and
  * the fixed-step methods, spans of the size a 4th-order method would take
  * first), and after each step [ta, tb] it looks for sign changes of each g on
- * a continuous extension of the step: the quintic Hermite interpolant of the
+ * a continuous extension of the step. First a screen: the cubic Hermite
+ * interpolant of the step's ends, whose error is estimated from its defect
+ * (one evaluation of the system); a step where no g comes near 0 on it, by a
+ * margin of that error, or changes sign only in a direction not asked for,
+ * costs nothing more. Other steps get the quintic Hermite interpolant of the
  * states and derivatives at the step's start, middle and end (the middle
  * state integrated from the start, which costs about a step more), sampled
  * at SICM_ODE_EVENT_SAMPLES equal sub-intervals, so that two crossings in
  * one step are both found. Each sign change is placed by Brent's method, first
  * on the interpolant, then on the solution itself: each trial time is
- * reached by integrating from the step's start with the same method and
+ * reached by integrating from the step's start, or from the last trial if
+ * nearer, with the same method and
  * tolerances, so a located event is as accurate as the integration (the
  * interpolant only brackets it), to a few ulps of the time since the
  * step's start (the trial integrations run in that time, so the state at
@@ -294,6 +299,7 @@ long sicm_ode_stopping_event(const sicm_ode *o);
 typedef struct {
   unsigned long located;
   unsigned long iterations;
+  unsigned long screened; /* steps the cubic screen found free of events */
 } sicm_ode_event_stats;
 const sicm_ode_event_stats *sicm_ode_get_event_stats(const sicm_ode *o);
 
