@@ -32,6 +32,7 @@ typedef struct {
   double *y_trial; /* the solution at the last trial time, s_trial, if have_trial */
   double s_trial;
   int have_trial;
+  int located; /* an event was located in this step */
   double *y_best; /* at the trial where |g| was smallest */
   double s_best, g_best;
   int have_best;
@@ -526,6 +527,7 @@ static int events_of_step(step_data *d, double *t, double *y) {
       return sicm_ode_fail(o, status, d->ta, d->ya, "cannot place an event",
                            sicm_ode_last_error(o->event_solver));
     o->event_stats.located++;
+    d->located = 1;
     const double te = d->ta + d->s_best;
     const int stop =
         o->events[cs[c].k].terminal ||
@@ -586,8 +588,11 @@ static int evolve_events(sicm_ode *o, double *t, double t1, double *y) {
   status = sicm_ode_start_derivative(o, *t, y, fa);
   if (status != SICM_SUCCESS) return status;
   double last_step = 0;
-  for (unsigned long steps = 0; *t != t1; steps++) {
+  /* The limit on steps counts those between two events located, as it
+   * counts those between two calls of a monitor. */
+  for (unsigned long steps = 0; *t != t1; steps = d.located ? 0 : steps + 1) {
     if (steps >= o->max_steps) return sicm_ode_fail_max_steps(o, *t, y);
+    d.located = 0;
     d.ta = *t;
     memcpy(ya, y, dim * sizeof *y);
     /* One step of the method: the one its controller proposes, or, for the

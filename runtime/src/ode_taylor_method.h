@@ -104,11 +104,12 @@ static int NAME(step)(sicm_ode *o, NAME(state) * s, REAL limit, double *t, doubl
   }
   const REAL dir = limit > s->t ? 1 : -1;
   REAL h = dir * NAME(step_for)(o, s);
+  /* The step the series allows, even when this one is cut short at the
+   * limit: a caller that chooses its own spans (events: ode_events.c) asks
+   * for the next one as long. */
+  o->h = (double)h;
   const int final = FABS(h) >= FABS(limit - s->t);
-  if (final)
-    h = limit - s->t;
-  else
-    o->h = (double)h;
+  if (final) h = limit - s->t;
   /* The step the time will actually take: t + h rounds, and a state
    * advanced by the unrounded h would drift in phase from its time by an
    * ulp of t a step (3e-14 over ten periods of an oscillator). */
