@@ -404,8 +404,8 @@ static int gsl_evolve(sicm_ode *o, double *t, double t1, double *y) {
 
 #define GSL_STEP_TYPE(var, label, gsl_type, real, imaginary)                                       \
   static const gsl_method var##_method = {&gsl_type, {real, imaginary}};                           \
-  static const sicm_ode_step_type var##_type = {label,     gsl_init, gsl_evolve,                   \
-                                                gsl_reset, gsl_free, &var##_method};               \
+  static const sicm_ode_step_type var##_type = {label,    gsl_init,      gsl_evolve, gsl_reset,    \
+                                                gsl_free, &var##_method, NULL};                    \
   const sicm_ode_step_type *const sicm_ode_step_##var = &var##_type;
 
 /* The stability boundaries of GSL's explicit steppers (sicm_ode_stability),

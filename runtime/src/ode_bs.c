@@ -391,5 +391,5 @@ static int bs_evolve(sicm_ode *o, double *t, double t1, double *y) {
   return SICM_SUCCESS;
 }
 
-const sicm_ode_step_type sicm_ode_bs_type = {"bulirsch-stoer", bs_init, bs_evolve,
-                                             bs_reset,         bs_free, NULL};
+const sicm_ode_step_type sicm_ode_bs_type = {"bulirsch-stoer", bs_init, bs_evolve, bs_reset,
+                                             bs_free,          NULL,    NULL};

@@ -207,7 +207,7 @@ static int cv_evolve(sicm_ode *o, double *t, double t1, double *y) {
 
 static const int kAdams = CV_ADAMS, kBdf = CV_BDF;
 
-const sicm_ode_step_type sicm_ode_cvode_adams_type = {"cvode-adams", cv_init, cv_evolve,
-                                                      cv_reset,      cv_free, &kAdams};
-const sicm_ode_step_type sicm_ode_cvode_bdf_type = {"cvode-bdf", cv_init, cv_evolve,
-                                                    cv_reset,    cv_free, &kBdf};
+const sicm_ode_step_type sicm_ode_cvode_adams_type = {"cvode-adams", cv_init, cv_evolve, cv_reset,
+                                                      cv_free,       &kAdams, NULL};
+const sicm_ode_step_type sicm_ode_cvode_bdf_type = {"cvode-bdf", cv_init, cv_evolve, cv_reset,
+                                                    cv_free,     &kBdf,   NULL};

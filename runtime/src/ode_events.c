@@ -12,7 +12,17 @@
 
 #include "ode_internal.h"
 
-enum { kSamples = SICM_ODE_EVENT_SAMPLES, kMaxBrentIterations = 100, kGrowth = 4 };
+/* Brent's method converges only linearly on a root of odd multiplicity
+ * above 1 ((t - 1)^3): from a sample's interval to a few ulps takes it
+ * some 150 iterations. On the interpolant they cost little; on the
+ * solution each is an integration, and its bracket is narrow already. */
+enum {
+  kSamples = SICM_ODE_EVENT_SAMPLES,
+  kMaxBrentIterations = 100,
+  kMaxBrentIterationsInterpolant = 400,
+  kGrowth = 4
+};
+static const double kDenseShare = 0.9;
 
 /* A located crossing waiting to be placed: event k changes sign between
  * samples lo and hi of the step, in direction dir; tau is its time on the
@@ -21,6 +31,7 @@ typedef struct {
   size_t k;
   int lo, hi, dir;
   double tau;
+  double s; /* tau - ta, as found: late in a long run tau rounds to an ulp of t */
 } candidate;
 
 /* One step's data, and the trial points of the crossing being placed. */
@@ -32,7 +43,8 @@ typedef struct {
   double *y_trial; /* the solution at the last trial time, s_trial, if have_trial */
   double s_trial;
   int have_trial;
-  int located; /* an event was located in this step */
+  int located;    /* an event was located in this step */
+  int dense;      /* the method's own continuous output spans the step */
   double *y_best; /* at the trial where |g| was smallest */
   double s_best, g_best;
   int have_best;
@@ -314,6 +326,10 @@ static void interpolate(const step_data *d, double s, double *y) {
     memcpy(y, s == 0 ? d->ya : d->yb, d->o->dim * sizeof *y);
     return;
   }
+  if (d->dense) {
+    d->o->type->dense(d->o, d->ta, d->tb, s, y);
+    return;
+  }
   const double *c = work_slot(d->o, kSlotCoefficients);
   static const double z[kCoefficients] = {0, 0, 0.5, 0.5, 1, 1};
   for (size_t i = 0; i < d->o->dim; i++) {
@@ -335,13 +351,13 @@ static double interpolant_value(double s, void *params) {
 /* Brent's method on f over [lo, hi] (f(lo), f(hi) of opposite signs) to a
  * bracket of a few ulps of s; returns its last estimate. */
 static double brent(double (*f)(double, void *), void *params, double lo, double hi, double h,
-                    const int *failed) {
+                    int iterations, const int *failed) {
   gsl_root_fsolver *solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
   if (!solver) return 0.5 * (lo + hi);
   gsl_function F = {f, params};
   double root = 0.5 * (lo + hi);
   if (gsl_root_fsolver_set(solver, &F, fmin(lo, hi), fmax(lo, hi)) == GSL_SUCCESS) {
-    for (int i = 0; i < kMaxBrentIterations && !(failed && *failed); i++) {
+    for (int i = 0; i < iterations && !(failed && *failed); i++) {
       if (gsl_root_fsolver_iterate(solver) != GSL_SUCCESS) break;
       root = gsl_root_fsolver_root(solver);
       const double a = gsl_root_fsolver_x_lower(solver), b = gsl_root_fsolver_x_upper(solver);
@@ -404,9 +420,19 @@ static int scan_solution(step_data *d, const candidate *c, double s0, double *lo
 enum { kNoCrossing = -1 };
 static int place(step_data *d, const candidate *c) {
   const double h = d->tb - d->ta;
+  if (d->dense) {
+    /* The method's own polynomial is its solution over the step: the
+     * crossing is its root, tau, found already. */
+    d->k = c->k;
+    d->s_best = c->s;
+    interpolate(d, d->s_best, d->y_best);
+    d->have_best = 1;
+    d->status = SICM_SUCCESS;
+    return SICM_SUCCESS;
+  }
   const double s_lo = (double)c->lo / kSamples * h,
                s_hi = c->hi == kSamples ? h : c->hi * h / kSamples;
-  const double s0 = c->tau - d->ta;
+  const double s0 = c->s;
   d->k = c->k;
   d->have_best = 0;
   d->cached = 0;
@@ -443,7 +469,7 @@ static int place(step_data *d, const candidate *c) {
   d->cache_s[0] = lo, d->cache_g[0] = g_lo;
   d->cache_s[1] = hi, d->cache_g[1] = g_hi;
   d->cached = 2;
-  brent(solution_value, d, lo, hi, h, &d->status);
+  brent(solution_value, d, lo, hi, h, kMaxBrentIterations, &d->status);
   if (d->status == SICM_SUCCESS && !d->have_best) {
     /* Brent evaluated nothing new: the bracket was already tight; take
      * the end with the smaller |g|. */
@@ -475,15 +501,21 @@ static int events_of_step(step_data *d, double *t, double *y) {
   double *g = sample_values(o);
   double *yi = work_slot(o, 3);
   d->have_trial = 0; /* y_trial is the screen's scratch, and the last step's */
-  if (step_is_free(d)) {
-    o->event_stats.screened++;
-    return SICM_SUCCESS;
+  /* The Taylor methods' steps are polynomials: the events are found on
+   * them, with no screen, interpolant or trial integration. */
+  d->dense = o->type->dense && o->type->dense(o, d->ta, d->tb, 0, NULL) == SICM_SUCCESS;
+  if (!d->dense) {
+    if (step_is_free(d)) {
+      o->event_stats.screened++;
+      return SICM_SUCCESS;
+    }
+    int status = fit_interpolant(d);
+    if (status == SICM_EUSER) return sicm_ode_fail_user(o, d->ta, d->ya);
+    if (status != SICM_SUCCESS)
+      return sicm_ode_fail(o, status, d->ta, d->ya, "cannot interpolate the step for its events",
+                           sicm_ode_last_error(o->event_solver));
   }
-  int status = fit_interpolant(d);
-  if (status == SICM_EUSER) return sicm_ode_fail_user(o, d->ta, d->ya);
-  if (status != SICM_SUCCESS)
-    return sicm_ode_fail(o, status, d->ta, d->ya, "cannot interpolate the step for its events",
-                         sicm_ode_last_error(o->event_solver));
+  int status;
   for (int j = 0; j <= kSamples; j++) {
     const double s = j == kSamples ? h : j * h / kSamples;
     interpolate(d, s, yi);
@@ -503,7 +535,7 @@ static int events_of_step(step_data *d, double *t, double *y) {
       if (sj == 0) continue;
       if (sign != 0 && sj != sign) {
         const int dir = sj > 0 ? SICM_ODE_EVENT_UP : SICM_ODE_EVENT_DOWN;
-        if (o->events[k].direction & dir) cs[count++] = (candidate){k, last, j, dir, 0};
+        if (o->events[k].direction & dir) cs[count++] = (candidate){k, last, j, dir, 0, 0};
       }
       sign = sj;
       last = j;
@@ -514,7 +546,8 @@ static int events_of_step(step_data *d, double *t, double *y) {
     d->k = cs[c].k;
     const double s_lo = cs[c].lo * h / kSamples,
                  s_hi = cs[c].hi == kSamples ? h : cs[c].hi * h / kSamples;
-    cs[c].tau = d->ta + brent(interpolant_value, d, s_lo, s_hi, h, NULL);
+    cs[c].s = brent(interpolant_value, d, s_lo, s_hi, h, kMaxBrentIterationsInterpolant, NULL);
+    cs[c].tau = d->ta + cs[c].s;
   }
   qsort(cs, count, sizeof *cs, compare_candidates);
   for (size_t c = 0; c < count; c++) {
@@ -607,6 +640,11 @@ static int evolve_events(sicm_ode *o, double *t, double t1, double *y) {
       if (status != SICM_SUCCESS) return sicm_ode_fail_user(o, d.ta, ya);
     }
     if (last_step != 0 && fabs(h) > kGrowth * last_step) h = copysign(kGrowth * last_step, h);
+    /* A method with its own continuous output (Taylor) is asked for a
+     * little less than its last step, so that it takes one step and the
+     * events are found on that step's polynomial (two steps would leave
+     * only the second's). */
+    if (o->type->dense) h *= kDenseShare;
     const double tb = fabs(h) >= fabs(t1 - d.ta) ? t1 : d.ta + h;
     const unsigned long steps0 = o->stats.steps;
     status = sicm_ode_evolve_plain(o, t, tb, y);

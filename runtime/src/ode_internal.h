@@ -27,6 +27,11 @@ struct sicm_ode_step_type {
   void (*reset)(sicm_ode *o);
   void (*free)(sicm_ode *o);
   const void *data; /* backend-specific: the GSL step type, the CVODE method */
+  /* The method's own continuous output, or NULL: if its last step spans
+   * exactly [ta, tb], writes into y (unless NULL) the solution at ta + s
+   * for s in [0, tb - ta] and returns SICM_SUCCESS; else SICM_EINVAL.
+   * Events (ode_events.c) are located on it when it is there. */
+  int (*dense)(sicm_ode *o, double ta, double tb, double s, double *y);
 };
 
 enum { SICM_ODE_MESSAGE_SIZE = 1024 };

@@ -316,7 +316,7 @@ static int qc_evolve(sicm_ode *o, double *t, double t1, double *y) {
   return SICM_SUCCESS;
 }
 
-const sicm_ode_step_type sicm_ode_qcrk4_type = {"qcrk4",  qc_init, qc_evolve,
-                                                qc_reset, qc_free, &kRk4};
-const sicm_ode_step_type sicm_ode_qcctrap2_type = {"qcctrap2", qc_init, qc_evolve,
-                                                   qc_reset,   qc_free, &kTrapezoid};
+const sicm_ode_step_type sicm_ode_qcrk4_type = {"qcrk4", qc_init, qc_evolve, qc_reset,
+                                                qc_free, &kRk4,   NULL};
+const sicm_ode_step_type sicm_ode_qcctrap2_type = {"qcctrap2", qc_init,     qc_evolve, qc_reset,
+                                                   qc_free,    &kTrapezoid, NULL};

@@ -445,14 +445,14 @@ static int fixed_evolve(sicm_ode *o, double *t, double t1, double *y) {
   return sicm_ode_fail(o, s, *t, y, out.what, out.detail);
 }
 
-static const sicm_ode_step_type verlet_type = {"verlet",    fixed_init, fixed_evolve,
-                                               fixed_reset, fixed_free, &verlet};
-static const sicm_ode_step_type yoshida4_type = {"yoshida4",  fixed_init, fixed_evolve,
-                                                 fixed_reset, fixed_free, &yoshida4};
-static const sicm_ode_step_type yoshida6_type = {"yoshida6",  fixed_init, fixed_evolve,
-                                                 fixed_reset, fixed_free, &yoshida6};
-static const sicm_ode_step_type yoshida8_type = {"yoshida8",  fixed_init, fixed_evolve,
-                                                 fixed_reset, fixed_free, &yoshida8};
+static const sicm_ode_step_type verlet_type = {"verlet",   fixed_init, fixed_evolve, fixed_reset,
+                                               fixed_free, &verlet,    NULL};
+static const sicm_ode_step_type yoshida4_type = {"yoshida4", fixed_init, fixed_evolve, fixed_reset,
+                                                 fixed_free, &yoshida4,  NULL};
+static const sicm_ode_step_type yoshida6_type = {"yoshida6", fixed_init, fixed_evolve, fixed_reset,
+                                                 fixed_free, &yoshida6,  NULL};
+static const sicm_ode_step_type yoshida8_type = {"yoshida8", fixed_init, fixed_evolve, fixed_reset,
+                                                 fixed_free, &yoshida8,  NULL};
 
 const sicm_ode_step_type *const sicm_ode_step_verlet = &verlet_type;
 const sicm_ode_step_type *const sicm_ode_step_yoshida4 = &yoshida4_type;

@@ -92,7 +92,8 @@ static int taylor_order(const sicm_ode *o) {
 #undef TAYLOR_METHOD_NAME
 #undef SET_COEFFICIENTS
 
-const sicm_ode_step_type sicm_ode_taylor_type = {"taylor",     taylor_init, taylor_evolve,
-                                                 taylor_reset, taylor_free, NULL};
+const sicm_ode_step_type sicm_ode_taylor_type = {
+    "taylor", taylor_init, taylor_evolve, taylor_reset, taylor_free, NULL, taylor_dense};
 const sicm_ode_step_type sicm_ode_taylor_extended_type = {
-    "taylor-extended", taylor_ext_init, taylor_ext_evolve, taylor_ext_reset, taylor_ext_free, NULL};
+    "taylor-extended", taylor_ext_init, taylor_ext_evolve, taylor_ext_reset, taylor_ext_free, NULL,
+    taylor_ext_dense};

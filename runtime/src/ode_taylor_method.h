@@ -149,6 +149,23 @@ static int NAME(step)(sicm_ode *o, NAME(state) * s, REAL limit, double *t, doubl
   return SICM_SUCCESS;
 }
 
+/* The step in hand's polynomial at s after ta, when the step spans exactly
+ * [ta, tb] (the step type's dense output: events are located on it). */
+static int NAME(dense)(sicm_ode *o, double ta, double tb, double s, double *y) {
+  NAME(state) *st = o->backend;
+  if (!st->have_step || (double)st->t0 != ta || (double)st->t != tb) return SICM_EINVAL;
+  if (!y) return SICM_SUCCESS;
+  const REAL tau = (REAL)ta - st->t0 + (REAL)s;
+  const int p = st->order;
+  for (size_t i = 0; i < o->dim; i++) {
+    REAL v = st->c[(size_t)p * o->dim + i];
+    for (int k = p - 1; k >= 0; k--)
+      v = v * tau + st->c[(size_t)k * o->dim + i];
+    y[i] = (double)v;
+  }
+  return SICM_SUCCESS;
+}
+
 static int NAME(evolve)(sicm_ode *o, double *t, double t1, double *y) {
   NAME(state) *s = o->backend;
   const size_t dim = o->dim;

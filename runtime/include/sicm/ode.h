@@ -251,7 +251,9 @@ int sicm_ode_evolve(sicm_ode *o, double *t, double t1, double *y);
  * one step are both found. Each sign change is placed by Brent's method, first
  * on the interpolant, then on the solution itself: each trial time is
  * reached by integrating from the step's start, or from the last trial if
- * nearer, with the same method and
+ * nearer (a method with its own continuous output, the Taylor methods,
+ * is asked for one step at a time and its polynomial stands for the
+ * interpolant and for the solution both), with the same method and
  * tolerances, so a located event is as accurate as the integration (the
  * interpolant only brackets it), to a few ulps of the time since the
  * step's start (the trial integrations run in that time, so the state at
