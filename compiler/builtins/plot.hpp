@@ -20,8 +20,8 @@ std::string plot_file_name(std::string_view title, int number);
 
 // What frame takes after its bounds: [title [x-label [y-label]]] as
 // strings, then options as pairs 'name value: 'aspect 'equal (or 'auto),
-// 'marker-size PIXELS, 'legend 'top-right (or 'top-left, 'bottom-left,
-// 'bottom-right, 'none). Errors are raised as MIT's argument errors.
+// 'marker-size PIXELS, 'legend 'best (or 'top-right, 'top-left,
+// 'bottom-left, 'bottom-right, 'none). Errors are raised as MIT's argument errors.
 struct FrameArguments {
   std::string title;
   std::vector<std::string> axis_labels; // x, then y

@@ -38,7 +38,8 @@ struct LegendPlace {
   const char *name;
   sicm_plot_legend where;
 };
-const LegendPlace kLegendPlaces[] = {{"top-right", SICM_PLOT_LEGEND_TOP_RIGHT},
+const LegendPlace kLegendPlaces[] = {{"best", SICM_PLOT_LEGEND_BEST},
+                                     {"top-right", SICM_PLOT_LEGEND_TOP_RIGHT},
                                      {"top-left", SICM_PLOT_LEGEND_TOP_LEFT},
                                      {"bottom-left", SICM_PLOT_LEGEND_BOTTOM_LEFT},
                                      {"bottom-right", SICM_PLOT_LEGEND_BOTTOM_RIGHT},
@@ -51,7 +52,8 @@ int legend_place(Value *a, int i, const char *who) {
     for (const LegendPlace &p : kLegendPlaces)
       if (symbol_name(a[i]) == p.name) return p.where;
   bad_range(a[i], i + 1, who,
-            "a legend is at 'top-right, 'top-left, 'bottom-left or 'bottom-right, or 'none");
+            "a legend is at 'best, 'top-right, 'top-left, 'bottom-left or 'bottom-right, or "
+            "'none");
 }
 
 // The option name at a[i], which must have a value after it.

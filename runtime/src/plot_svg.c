@@ -319,6 +319,47 @@ static size_t text_length(const char *s) {
 
 enum { kRow = 18, kPad = 6, kSwatch = 24, kCharWidth = 7, kInset = 8 };
 
+/* The top left (*x, *y) of a w x h legend in a corner of the frame. */
+static void corner_box(const area *a, sicm_plot_legend where, double w, double h, double *x,
+                       double *y) {
+  const int right = where == SICM_PLOT_LEGEND_TOP_RIGHT || where == SICM_PLOT_LEGEND_BOTTOM_RIGHT;
+  const int bottom =
+      where == SICM_PLOT_LEGEND_BOTTOM_LEFT || where == SICM_PLOT_LEGEND_BOTTOM_RIGHT;
+  *x = right ? a->left + a->width - kInset - w : a->left + kInset;
+  *y = bottom ? a->top + a->height - kInset - h : a->top + kInset;
+}
+
+static int in_box(double x, double y, double bx, double by, double w, double h) {
+  return x >= bx && x <= bx + w && y >= by && y <= by + h;
+}
+
+/* The corner where a w x h legend covers the fewest marks: points, and the
+ * ends and middles of segments (a sample that sees a line crossing the
+ * box, at the scale of a legend). Ties go to the first corner tried. */
+static sicm_plot_legend best_corner(const sicm_plot *p, const area *a, double w, double h) {
+  static const sicm_plot_legend corners[] = {SICM_PLOT_LEGEND_TOP_RIGHT, SICM_PLOT_LEGEND_TOP_LEFT,
+                                             SICM_PLOT_LEGEND_BOTTOM_RIGHT,
+                                             SICM_PLOT_LEGEND_BOTTOM_LEFT};
+  size_t covered[4] = {0, 0, 0, 0};
+  double bx[4], by[4];
+  for (int c = 0; c < 4; ++c)
+    corner_box(a, corners[c], w, h, &bx[c], &by[c]);
+  for (size_t i = 0; i < p->n; ++i) {
+    const sicm_plot_mark *m = &p->marks[i];
+    double xs[3] = {m->x0, m->x1, (m->x0 + m->x1) / 2}, ys[3] = {m->y0, m->y1, (m->y0 + m->y1) / 2};
+    const int samples = isnan(m->x1) ? 1 : 3;
+    for (int k = 0; k < samples; ++k) {
+      const double x = px(p, a, xs[k]), y = py(p, a, ys[k]);
+      for (int c = 0; c < 4; ++c)
+        covered[c] += in_box(x, y, bx[c], by[c], w, h);
+    }
+  }
+  int best = 0;
+  for (int c = 1; c < 4; ++c)
+    if (covered[c] < covered[best]) best = c;
+  return corners[best];
+}
+
 static void write_legend(FILE *f, const sicm_plot *p, const area *a, series_view *const *rows,
                          size_t n) {
   if (n == 0 || p->legend == SICM_PLOT_LEGEND_NONE) return;
@@ -329,12 +370,10 @@ static void write_legend(FILE *f, const sicm_plot *p, const area *a, series_view
   }
   const double w = kPad + kSwatch + kPad + (double)longest * kCharWidth + kPad;
   const double h = (double)n * kRow + kPad;
-  const int right =
-      p->legend == SICM_PLOT_LEGEND_TOP_RIGHT || p->legend == SICM_PLOT_LEGEND_BOTTOM_RIGHT;
-  const int bottom =
-      p->legend == SICM_PLOT_LEGEND_BOTTOM_LEFT || p->legend == SICM_PLOT_LEGEND_BOTTOM_RIGHT;
-  const double x = right ? a->left + a->width - kInset - w : a->left + kInset;
-  const double y = bottom ? a->top + a->height - kInset - h : a->top + kInset;
+  const sicm_plot_legend where =
+      p->legend == SICM_PLOT_LEGEND_BEST ? best_corner(p, a, w, h) : p->legend;
+  double x, y;
+  corner_box(a, where, w, h, &x, &y);
   fprintf(f, "<g class=\"legend\">\n");
   fprintf(f,
           "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"white\" "

@@ -366,3 +366,23 @@ TEST(PlotSvg, LegendPlacement) {
   EXPECT_EQ(sicm_plot_set_legend(p, static_cast<sicm_plot_legend>(17)), -1);
   sicm_plot_free(p);
 }
+
+// By default the legend takes the corner where it hides the fewest marks.
+TEST(PlotSvg, LegendAvoidsTheMarks) {
+  std::string dir = temp_dir();
+  // Marks crowd every corner but the bottom left, whatever the legend's size.
+  sicm_plot *p = sicm_plot_open(dir.c_str(), "b", nullptr, 0, 1, 0, 1);
+  for (int i = 0; i <= 100; ++i)
+    for (int j = 0; j <= 100; ++j)
+      if (i > 30 || j > 30)
+        sicm_plot_series_point(p, (i + j) % 2 ? "odd" : "even", i / 100.0, j / 100.0);
+  sicm_plot_free(p);
+  std::vector<Element> svg = parse_file(dir + "/b.svg");
+  const Element *frame = frame_rect(svg);
+  const Element *box = nullptr;
+  for (const Element &e : svg)
+    if (e.name == "rect" && e.attributes.count("fill-opacity")) box = &e;
+  ASSERT_NE(box, nullptr);
+  EXPECT_LT(attr(*box, "x"), attr(*frame, "x") + attr(*frame, "width") / 2);  // left
+  EXPECT_GT(attr(*box, "y"), attr(*frame, "y") + attr(*frame, "height") / 2); // bottom
+}

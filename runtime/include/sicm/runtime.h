@@ -91,16 +91,19 @@ int sicm_plot_series_line(sicm_plot *p, const char *series, double x0, double y0
  * and, if connect is non-zero, joined in the order they came by a polyline. */
 int sicm_plot_style_series(sicm_plot *p, const char *series, double marker_size, int connect);
 
-/* Frame options. The default dot size, for every series not styled with
- * its own: marker_size pixels, or (negative, the default) by the number of
- * points in the plot: 4 below 300 points, 3 below 3000, else 2, so that a
- * sparse section stays visible and a dense one does not blot. */
+/* Frame options (each may be set any time before the plot is finished). The default dot size, for
+ * every series not styled with its own: marker_size pixels, or (negative, the default) by the
+ * number of points in the plot: 4 below 300 points, 3 below 3000, else 2, so that a sparse section
+ * stays visible and a dense one does not blot. */
 int sicm_plot_set_marker_size(sicm_plot *p, double marker_size);
 /* Equal aspect (non-zero): a unit of x is as long on the page as a unit of
  * y; the frame is shrunk along one axis and centred. */
 int sicm_plot_set_equal_aspect(sicm_plot *p, int equal);
-/* Where the legend of the named series goes (none without named series). */
+/* Where the legend of the named series goes (none without named series):
+ * BEST, the default, is the corner inside the frame where it hides the
+ * fewest marks (top right, top left, bottom right, bottom left on ties). */
 typedef enum {
+  SICM_PLOT_LEGEND_BEST,
   SICM_PLOT_LEGEND_TOP_RIGHT,
   SICM_PLOT_LEGEND_TOP_LEFT,
   SICM_PLOT_LEGEND_BOTTOM_LEFT,
