@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 
 #include "base/number.hpp"
@@ -42,43 +43,64 @@ double arg_real(Value *a, int i, const char *who) {
   return to_double(a[i]);
 }
 
-// (frame xmin xmax ymin ymax [title [x-label y-label]])
+// (frame xmin xmax ymin ymax [title [x-label y-label]] option value ...)
 Value P_frame(Value *a, int n) {
   double r[4];
   for (int i = 0; i < 4; ++i)
     r[i] = arg_real(a, i, "frame");
   if (!(r[1] > r[0])) bad_range(a[1], 2, "frame");
   if (!(r[3] > r[2])) bad_range(a[3], 4, "frame");
+  FrameArguments f = frame_arguments(a, n, "frame");
   ++g_plot_count;
-  std::string title = n > 4 ? std::string(arg_string(a, 4, "frame")) : "";
-  std::string name = plot_file_name(title, g_plot_count);
-  std::string x_label = n > 5 ? std::string(arg_string(a, 5, "frame")) : "";
-  std::string y_label = n > 6 ? std::string(arg_string(a, 6, "frame")) : "";
-  sicm_plot *p = sicm_plot_open(g_plot_dir.c_str(), name.c_str(),
-                                title.empty() ? nullptr : title.c_str(), r[0], r[1], r[2], r[3]);
+  std::string name = plot_file_name(f.title, g_plot_count);
+  sicm_plot *p =
+      sicm_plot_open(g_plot_dir.c_str(), name.c_str(), f.title.empty() ? nullptr : f.title.c_str(),
+                     r[0], r[1], r[2], r[3]);
   if (!p)
     runtime_error(current_call_loc(), "frame: cannot create the plot file " + g_plot_dir + "/" +
                                           name + ".tsv: " + std::strerror(errno));
-  if (n > 5 && sicm_plot_set_labels(p, x_label.c_str(), n > 6 ? y_label.c_str() : nullptr) != 0)
+  if (!f.axis_labels.empty() &&
+      sicm_plot_set_labels(p, f.axis_labels[0].c_str(),
+                           f.axis_labels.size() > 1 ? f.axis_labels[1].c_str() : nullptr) != 0)
     runtime_error(current_call_loc(), "frame: out of memory");
+  sicm_plot_set_equal_aspect(p, f.equal_aspect);
+  sicm_plot_set_marker_size(p, f.marker_size);
+  sicm_plot_set_legend(p, static_cast<sicm_plot_legend>(f.legend));
   PlotWindow *w = gc_new<PlotWindow>(PlotWindow{p, gc_strdup(name)});
   return Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kPlotKind, w}));
 }
 
-Value P_plot_point(Value *a, int) {
+// (plot-point window x y [series])
+Value P_plot_point(Value *a, int n) {
   PlotWindow *w = arg_window(a, 0, "plot-point");
-  if (sicm_plot_point(w->plot, arg_real(a, 1, "plot-point"), arg_real(a, 2, "plot-point")) != 0)
+  double x = arg_real(a, 1, "plot-point"), y = arg_real(a, 2, "plot-point");
+  std::optional<std::string> series = n > 3 ? series_argument(a, 3, "plot-point") : std::nullopt;
+  if (sicm_plot_series_point(w->plot, series ? series->c_str() : nullptr, x, y) != 0)
     runtime_error(current_call_loc(), "plot-point: the plot is closed or memory is exhausted");
   return Value::unspecified();
 }
 
-Value P_plot_line(Value *a, int) {
+// (plot-line window x0 y0 x1 y1 [series])
+Value P_plot_line(Value *a, int n) {
   PlotWindow *w = arg_window(a, 0, "plot-line");
   double c[4];
   for (int i = 0; i < 4; ++i)
     c[i] = arg_real(a, i + 1, "plot-line");
-  if (sicm_plot_line(w->plot, c[0], c[1], c[2], c[3]) != 0)
+  std::optional<std::string> series = n > 5 ? series_argument(a, 5, "plot-line") : std::nullopt;
+  if (sicm_plot_series_line(w->plot, series ? series->c_str() : nullptr, c[0], c[1], c[2], c[3]) !=
+      0)
     runtime_error(current_call_loc(), "plot-line: the plot is closed or memory is exhausted");
+  return Value::unspecified();
+}
+
+// (plot-series window series option value ...)
+Value P_plot_series(Value *a, int n) {
+  PlotWindow *w = arg_window(a, 0, "plot-series");
+  std::optional<std::string> series = series_argument(a, 1, "plot-series");
+  SeriesStyle style = series_style(a, 2, n, "plot-series");
+  if (sicm_plot_style_series(w->plot, series ? series->c_str() : nullptr, style.marker_size,
+                             style.connect) != 0)
+    runtime_error(current_call_loc(), "plot-series: out of memory");
   return Value::unspecified();
 }
 
@@ -112,9 +134,10 @@ void set_plot_directory(const std::string &dir) {
 }
 
 void install_plot_primitives() {
-  define_primitive("frame", 4, 7, Stage::Effect, P_frame);
-  define_primitive("plot-point", 3, 3, Stage::Effect, P_plot_point);
-  define_primitive("plot-line", 5, 5, Stage::Effect, P_plot_line);
+  define_primitive("frame", 4, kVariadic, Stage::Effect, P_frame);
+  define_primitive("plot-point", 3, 4, Stage::Effect, P_plot_point);
+  define_primitive("plot-line", 5, 6, Stage::Effect, P_plot_line);
+  define_primitive("plot-series", 2, kVariadic, Stage::Effect, P_plot_series);
   define_primitive("graphics-close", 1, 1, Stage::Effect, P_graphics_close);
   define_primitive("graphics-clear", 1, 1, Stage::Effect, P_graphics_clear);
 }

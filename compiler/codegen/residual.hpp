@@ -24,6 +24,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -71,9 +72,11 @@ enum class RKind : uint8_t {
   Text,        // print `text`
   Let,         // var = compute(args)
   Print,       // print var (by its type)
-  Frame,       // plot `plot` = frame(args[0..3]) named `text`, titled `title`, axis_labels
-  PlotPoint,   // plot-point plot args[0] args[1]
-  PlotLine,    // plot-line plot args[0..3]
+  Frame,       // plot `plot` = frame(args[0..3]) named `text`, titled `title`, axis_labels,
+               // options `plot_options`
+  PlotPoint,   // plot-point plot args[0] args[1] [series]
+  PlotLine,    // plot-line plot args[0..3] [series]
+  PlotStyle,   // plot-series plot series: its marker size and connect in `plot_options`
   Close,       // graphics-close plot
   SetCell,     // cell `cell` = args[0]
   If,          // if (args[0] != 0) then_body else else_body
@@ -100,6 +103,15 @@ enum class RKind : uint8_t {
                // empty `text`: the message printed since FailCapture
   FailCapture, // what prints from here on is the message of the Fail that follows (it
                // holds numbers computed at run time)
+};
+
+// A frame's options and a series' style, as the runtime takes them
+// (sicm_program_plot_options, sicm_program_plot_style).
+struct RPlotOptions {
+  bool equal_aspect = false; // Frame
+  int legend = 0;            // Frame: a sicm_plot_legend
+  double marker_size = -1;   // Frame, PlotStyle: negative for the default
+  bool connect = false;      // PlotStyle
 };
 
 struct RStmt {
@@ -132,6 +144,8 @@ struct RStmt {
   std::string text, title;
   std::vector<std::string> probe_texts;    // Advance, Evolve: the probe's outputs as text
   std::vector<std::string> axis_labels;    // Frame: x, then y (none, one or both)
+  std::optional<std::string> series;       // PlotPoint, PlotLine, PlotStyle: none: unnamed
+  RPlotOptions plot_options;               // Frame, PlotStyle
   SrcLoc loc;                              // the call, for run-time errors
   std::vector<RStmt> then_body, else_body; // If
 };

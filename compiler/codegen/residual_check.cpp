@@ -229,6 +229,10 @@ private:
       args(s, 4);
       plot(s);
       break;
+    case RKind::PlotStyle:
+      args(s, 0);
+      plot(s);
+      break;
     case RKind::Close: plot(s); break;
     case RKind::SetCell:
       args(s, 1);

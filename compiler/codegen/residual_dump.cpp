@@ -170,6 +170,7 @@ const char *statement_kind_name(RKind k) {
   case RKind::Frame: return "frame";
   case RKind::PlotPoint: return "plot-point";
   case RKind::PlotLine: return "plot-line";
+  case RKind::PlotStyle: return "plot-series";
   case RKind::Close: return "graphics-close";
   case RKind::SetCell: return "set-cell";
   case RKind::If: return "if";

@@ -498,6 +498,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     case RKind::Frame: return frame(s, prefix);
     case RKind::PlotPoint: return plot_point(s, prefix);
     case RKind::PlotLine: return plot_line(s, prefix);
+    case RKind::PlotStyle: return plot_style(s);
     case RKind::Close: return "sicm_plot_finish(plot" + std::to_string(s.plot) + ");\n";
     case RKind::SetCell: return set_cell(s, prefix);
     case RKind::ListNew: return list_new(s);
@@ -608,22 +609,47 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       code += "sicm_program_plot_labels(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
               c_string_literal(s.axis_labels[0]) + ", " +
               (s.axis_labels.size() > 1 ? c_string_literal(s.axis_labels[1]) : "NULL") + ");\n";
+    const RPlotOptions &o = s.plot_options;
+    if (o.equal_aspect || o.legend != 0 || o.marker_size >= 0)
+      code += "sicm_program_plot_options(" + site(s.loc) + ", plot" + std::to_string(s.plot) +
+              ", " + (o.equal_aspect ? "1" : "0") + ", " + c_double_literal(o.marker_size) + ", " +
+              std::to_string(o.legend) + ");\n";
     return code;
+  }
+
+  // A series name as C: a string literal, or NULL for the unnamed series.
+  static std::string series_literal(const RStmt &s) {
+    return s.series ? c_string_literal(*s.series) : "NULL";
+  }
+
+  std::string plot_style(const RStmt &s) {
+    return "sicm_program_plot_style(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
+           series_literal(s) + ", " + c_double_literal(s.plot_options.marker_size) + ", " +
+           (s.plot_options.connect ? "1" : "0") + ");\n";
   }
 
   std::string plot_point(const RStmt &s, const std::string &prefix) {
     std::string code;
     std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
-    code += "sicm_program_plot_point(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
-            a[0] + ", " + a[1] + ");\n";
+    if (s.series)
+      code += "sicm_program_plot_series_point(" + site(s.loc) + ", plot" + std::to_string(s.plot) +
+              ", " + series_literal(s) + ", " + a[0] + ", " + a[1] + ");\n";
+    else
+      code += "sicm_program_plot_point(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
+              a[0] + ", " + a[1] + ");\n";
     return code;
   }
 
   std::string plot_line(const RStmt &s, const std::string &prefix) {
     std::string code;
     std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
-    code += "sicm_program_plot_line(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
-            a[0] + ", " + a[1] + ", " + a[2] + ", " + a[3] + ");\n";
+    if (s.series)
+      code += "sicm_program_plot_series_line(" + site(s.loc) + ", plot" + std::to_string(s.plot) +
+              ", " + series_literal(s) + ", " + a[0] + ", " + a[1] + ", " + a[2] + ", " + a[3] +
+              ");\n";
+    else
+      code += "sicm_program_plot_line(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ", " +
+              a[0] + ", " + a[1] + ", " + a[2] + ", " + a[3] + ");\n";
     return code;
   }
 
@@ -806,6 +832,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       case RKind::ListConst:
       case RKind::Crossings:
       case RKind::Frame:
+      case RKind::PlotStyle:
       case RKind::Close: return true;
       default: break;
       }

@@ -1,4 +1,4 @@
-// `sicm build`'s plots: frame, plot-point, plot-line and graphics-close
+// `sicm build`'s plots: frame, plot-point, plot-line, plot-series and graphics-close
 // record statements of the residual program, so that the built program
 // draws what `sicm run` draws; a graphics device is the number of its plot.
 // Part of build mode (the design is in pe/build_mode.cpp; the shared
@@ -48,29 +48,46 @@ Value P_frame(Value *a, int n) {
   }
   if (!(r[1] > r[0])) bad_range(a[1], 2, who);
   if (!(r[3] > r[2])) bad_range(a[3], 4, who);
+  FrameArguments f = frame_arguments(a, n, who);
   s.plot = ++g_build->program.plots;
-  s.title = n > 4 ? std::string(arg_string(a, 4, who)) : "";
+  s.title = f.title;
   s.text = plot_file_name(s.title, s.plot);
-  for (int i = 5; i < n; ++i) // the axis labels
-    s.axis_labels.emplace_back(arg_string(a, i, who));
+  s.axis_labels = f.axis_labels;
+  s.plot_options.equal_aspect = f.equal_aspect;
+  s.plot_options.marker_size = f.marker_size;
+  s.plot_options.legend = f.legend;
   BuildPlot *p = gc_new<BuildPlot>(BuildPlot{s.plot, gc_strdup(s.text)});
   emit(std::move(s));
   return Value::object(Tag::Opaque, gc_new<Opaque>(Opaque{&kBuildPlotKind, p}));
 }
 
-Value P_plot_point(Value *a, int) {
+Value P_plot_point(Value *a, int n) {
   RStmt s{RKind::PlotPoint};
   s.plot = arg_plot(a, 0, "plot-point")->id;
   s.args = {expr_of(a[1], "plot-point"), expr_of(a[2], "plot-point")};
+  if (n > 3) s.series = series_argument(a, 3, "plot-point");
   emit(std::move(s));
   return Value::unspecified();
 }
 
-Value P_plot_line(Value *a, int) {
+Value P_plot_line(Value *a, int n) {
   RStmt s{RKind::PlotLine};
   s.plot = arg_plot(a, 0, "plot-line")->id;
   for (int i = 1; i <= 4; ++i)
     s.args.push_back(expr_of(a[i], "plot-line"));
+  if (n > 5) s.series = series_argument(a, 5, "plot-line");
+  emit(std::move(s));
+  return Value::unspecified();
+}
+
+Value P_plot_series(Value *a, int n) {
+  RStmt s{RKind::PlotStyle};
+  s.loc = here();
+  s.plot = arg_plot(a, 0, "plot-series")->id;
+  s.series = series_argument(a, 1, "plot-series");
+  SeriesStyle style = series_style(a, 2, n, "plot-series");
+  s.plot_options.marker_size = style.marker_size;
+  s.plot_options.connect = style.connect;
   emit(std::move(s));
   return Value::unspecified();
 }
@@ -91,6 +108,7 @@ Value P_graphics_clear(Value *a, int) {
 
 // What this file specializes (the table is pe/specialized.cpp).
 const PrimFn p_frame = P_frame, p_plot_point = P_plot_point, p_plot_line = P_plot_line,
-             p_graphics_close = P_graphics_close, p_graphics_clear = P_graphics_clear;
+             p_plot_series = P_plot_series, p_graphics_close = P_graphics_close,
+             p_graphics_clear = P_graphics_clear;
 
 } // namespace sicm::build

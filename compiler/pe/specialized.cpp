@@ -79,9 +79,10 @@ const std::vector<Specialization> &specializations() {
       {"crossings", 1, kVariadic, p_crossings},
 
       // Plots record statements (pe/plots.cpp).
-      {"frame", 4, 7, p_frame},
-      {"plot-point", 3, 3, p_plot_point},
-      {"plot-line", 5, 5, p_plot_line},
+      {"frame", 4, kVariadic, p_frame},
+      {"plot-point", 3, 4, p_plot_point},
+      {"plot-line", 5, 6, p_plot_line},
+      {"plot-series", 2, kVariadic, p_plot_series},
       {"graphics-close", 1, 1, p_graphics_close},
       {"graphics-clear", 1, 1, p_graphics_clear},
 

@@ -51,7 +51,8 @@ extern const PrimFn p_definite_integral, p_minimize, p_brent_min, p_multidimensi
     p_find_root, p_nelder_mead, p_bisect, p_state_advancer, p_evolve, p_crossings;
 
 // ---- pe/plots.cpp: plots record statements ----------------------------------------------
-extern const PrimFn p_frame, p_plot_point, p_plot_line, p_graphics_close, p_graphics_clear;
+extern const PrimFn p_frame, p_plot_point, p_plot_line, p_plot_series, p_graphics_close,
+    p_graphics_clear;
 
 // ---- pe/lists.cpp: lists whose length is known only at run time -------------------------
 extern const PrimFn p_car, p_cdr, p_null_p, p_pair_p, p_list_p, p_length, p_reverse, p_list_ref,

@@ -97,8 +97,10 @@ void sicm_parallel_failing(void) {
 enum { kText = 'T', kPoint = 'P', kLine = 'L' };
 
 /* A record: its tag, then for kText a uint64 length and the bytes, for
- * kPoint a uint64 plot reference and x, y, for kLine the reference and x0,
- * y0, x1, y1. Fields are unaligned (memcpy). Consecutive texts are merged. */
+ * kPoint a uint64 plot reference, the series' name (a uint64 length, 0 for
+ * the unnamed series, and the bytes) and x, y, for kLine the reference, the
+ * name and x0, y0, x1, y1. Fields are unaligned (memcpy). Consecutive texts
+ * are merged. */
 typedef struct {
   unsigned char *bytes;
   size_t len, cap;
@@ -187,24 +189,29 @@ int sicm_parallel_log_text(const char *s, size_t len) {
   return 1;
 }
 
-static void log_mark(unsigned char tag, sicm_plot *plot, const double *xs, size_t count) {
+static void log_mark(unsigned char tag, sicm_plot *plot, const char *series, const double *xs,
+                     size_t count) {
   running->m->log.text_len_at = 0;
   log_put(&tag, 1);
   log_u64((uint64_t)(uintptr_t)plot);
+  const size_t name_len = series ? strlen(series) : 0;
+  log_u64(name_len);
+  log_put(series ? series : "", name_len);
   log_put(xs, count * sizeof *xs);
 }
 
-int sicm_parallel_log_point(sicm_plot *plot, double x, double y) {
+int sicm_parallel_log_point(sicm_plot *plot, const char *series, double x, double y) {
   if (!running) return 0;
   const double xs[2] = {x, y};
-  log_mark(kPoint, plot, xs, 2);
+  log_mark(kPoint, plot, series, xs, 2);
   return 1;
 }
 
-int sicm_parallel_log_line(sicm_plot *plot, double x0, double y0, double x1, double y1) {
+int sicm_parallel_log_line(sicm_plot *plot, const char *series, double x0, double y0, double x1,
+                           double y1) {
   if (!running) return 0;
   const double xs[4] = {x0, y0, x1, y1};
-  log_mark(kLine, plot, xs, 4);
+  log_mark(kLine, plot, series, xs, 4);
   return 1;
 }
 
@@ -230,6 +237,19 @@ static void walk_log(const sicm_site *site, unsigned char *bytes, size_t len, in
       at += (size_t)v;
       continue;
     }
+    const size_t ref_at = at - sizeof v;
+    uint64_t name_len;
+    memcpy(&name_len, bytes + at, sizeof name_len);
+    at += sizeof name_len;
+    /* The name is copied out to end it with a NUL (the log has none). */
+    char *series = NULL;
+    if (replay && name_len > 0) {
+      series = malloc((size_t)name_len + 1);
+      if (!series) sicm_program_fail(site, kWho, "out of memory for what the members plot");
+      memcpy(series, bytes + at, (size_t)name_len);
+      series[name_len] = '\0';
+    }
+    at += (size_t)name_len;
     double xs[4];
     const size_t count = tag == kPoint ? 2 : 4;
     memcpy(xs, bytes + at, count * sizeof *xs);
@@ -238,16 +258,16 @@ static void walk_log(const sicm_site *site, unsigned char *bytes, size_t len, in
       /* A plot not made by sicm_program_frame has no number: dropped. */
       const size_t number = sicm_program_frame_number((sicm_plot *)(uintptr_t)v);
       const uint64_t ref = number == SIZE_MAX ? UINT64_MAX : (uint64_t)number;
-      memcpy(bytes + at - count * sizeof *xs - sizeof ref, &ref, sizeof ref);
+      memcpy(bytes + ref_at, &ref, sizeof ref);
       continue;
     }
     sicm_plot *plot = numbered ? (v == UINT64_MAX ? NULL : sicm_program_frame_at((size_t)v))
                                : (sicm_plot *)(uintptr_t)v;
-    if (!plot) continue;
-    if (tag == kPoint)
-      sicm_program_plot_point(site, plot, xs[0], xs[1]);
-    else
-      sicm_program_plot_line(site, plot, xs[0], xs[1], xs[2], xs[3]);
+    if (plot && tag == kPoint)
+      sicm_program_plot_series_point(site, plot, series, xs[0], xs[1]);
+    else if (plot)
+      sicm_program_plot_series_line(site, plot, series, xs[0], xs[1], xs[2], xs[3]);
+    free(series);
   }
 }
 

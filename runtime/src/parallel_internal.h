@@ -24,8 +24,9 @@ extern "C" {
  * text (len bytes), the point or the segment to the member's log and return
  * 1; otherwise return 0 and do nothing. */
 int sicm_parallel_log_text(const char *s, size_t len);
-int sicm_parallel_log_point(sicm_plot *plot, double x, double y);
-int sicm_parallel_log_line(sicm_plot *plot, double x0, double y0, double x1, double y1);
+int sicm_parallel_log_point(sicm_plot *plot, const char *series, double x, double y);
+int sicm_parallel_log_line(sicm_plot *plot, const char *series, double x0, double y0, double x1,
+                           double y1);
 
 /* When the calling thread runs a member of a buffered sweep, record
  * `message` (sicm_program_fail's whole stderr text, malloc'd, which the

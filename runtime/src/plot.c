@@ -1,6 +1,7 @@
 /* Plot files: every frame becomes NAME.tsv (the raw points, written as the
- * run goes) and NAME.svg (axes, ticks, labels, points), finished when the
- * frame is closed, at exit, or on SIGINT/SIGTERM.
+ * run goes) and NAME.svg (axes, ticks, labels, points, a legend; drawn by
+ * plot_svg.c), finished when the frame is closed, at exit, or on
+ * SIGINT/SIGTERM. Marks belong to series, found here by name.
  *
  * Nothing is lost on interruption: points are kept in memory and appended to
  * the TSV file as they arrive (flushed at least every kFlushEvery points and
@@ -20,32 +21,17 @@
 #include <math.h>
 #include <signal.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "plot_internal.h"
 #include "sicm/runtime.h"
 
 enum { kFlushEvery = 4096, kMaxOpenPlots = 256 };
-
-typedef struct {
-  double x0, y0, x1, y1; /* a point has x1 = NAN */
-} mark;
-
-struct sicm_plot {
-  char *path;              /* NAME without extension, in its directory */
-  char *title;             /* shown above the picture */
-  char *x_label, *y_label; /* under the x axis, beside the y axis; NULL for none */
-  double xmin, xmax, ymin, ymax;
-  FILE *tsv;
-  mark *marks;
-  size_t n, cap;
-  size_t unflushed;
-  int closed;
-  int silent; /* sicm_plot_open_silent: no files, no marks kept */
-};
 
 static sicm_plot *open_plots[kMaxOpenPlots];
 static int handlers_installed;
@@ -167,6 +153,7 @@ sicm_plot *sicm_plot_open(const char *dir, const char *name, const char *title, 
     return NULL;
   }
   snprintf(p->path, len, "%s/%s", dir ? dir : ".", name);
+  p->marker_size = -1;
   p->xmin = xmin;
   p->xmax = xmax;
   p->ymin = ymin;
@@ -200,6 +187,7 @@ sicm_plot *sicm_plot_open_silent(const char *name) {
     return NULL;
   }
   p->silent = 1;
+  p->marker_size = -1;
   return p;
 }
 
@@ -218,30 +206,71 @@ int sicm_plot_set_labels(sicm_plot *p, const char *x_label, const char *y_label)
   return 0;
 }
 
-static int add_mark(sicm_plot *p, mark m) {
+/* The index of the series named `name` (NULL: the unnamed one, index 0),
+ * made if it is new; SIZE_MAX if memory runs out. Plots have a few series, and marks come in runs
+ * of one series, so the last one found is tried first. */
+static size_t find_series(sicm_plot *p, const char *name) {
+  if (p->n_series == 0) { /* the unnamed series is index 0 from the start */
+    p->series = calloc(4, sizeof *p->series);
+    if (!p->series) return SIZE_MAX;
+    p->series_cap = 4;
+    p->series[0] = (sicm_plot_series_info){NULL, -1, -1, 0, 0};
+    p->n_series = 1;
+  }
+  if (!name) return 0;
+  const size_t last = p->last_series;
+  if (last < p->n_series && p->series[last].name && strcmp(p->series[last].name, name) == 0)
+    return last;
+  for (size_t i = 1; i < p->n_series; ++i)
+    if (strcmp(p->series[i].name, name) == 0) return p->last_series = i;
+  if (p->n_series == p->series_cap) {
+    sicm_plot_series_info *grown = realloc(p->series, 2 * p->series_cap * sizeof *grown);
+    if (!grown) return SIZE_MAX;
+    p->series = grown;
+    p->series_cap *= 2;
+  }
+  char *copy = dup_string(name);
+  if (!copy) return SIZE_MAX;
+  p->series[p->n_series] = (sicm_plot_series_info){copy, -1, -1, 0, 0};
+  return p->last_series = p->n_series++;
+}
+
+static int add_mark(sicm_plot *p, sicm_plot_mark m) {
   if (p->closed) {
     errno = EINVAL;
     return -1;
   }
   if (p->n == p->cap) {
     size_t cap = p->cap ? 2 * p->cap : 1024;
-    mark *grown = realloc(p->marks, cap * sizeof *grown);
+    sicm_plot_mark *grown = realloc(p->marks, cap * sizeof *grown);
     if (!grown) return -1;
     p->marks = grown;
     p->cap = cap;
+  }
+  sicm_plot_series_info *s = &p->series[m.series];
+  if (s->name && s->rank < 0) s->rank = p->ranked++; /* its colour and legend row */
+  if (isnan(m.x1)) {
+    ++s->points;
+    ++p->points;
   }
   p->marks[p->n++] = m;
   return 0;
 }
 
-static int add_point(sicm_plot *p, double x, double y);
-static int add_line(sicm_plot *p, double x0, double y0, double x1, double y1);
+static int add_mark_in(sicm_plot *p, const char *series, const double *xs, size_t count);
 
 static void write_tsv_number(FILE *f, double x) {
   char buf[SICM_DOUBLE_BUFSIZE];
   /* The TSV holds plain C numbers (0.5, not MIT's .5) so any tool reads it. */
   snprintf(buf, sizeof buf, "%.17g", x);
   fputs(buf, f);
+}
+
+/* A series name as the TSV's last column: one field on one line. */
+static void write_tsv_name(FILE *f, const char *name) {
+  fputc('\t', f);
+  for (; *name; ++name)
+    fputc(*name == '\t' || *name == '\n' || *name == '\r' ? ' ' : *name, f);
 }
 
 static void after_write(sicm_plot *p) {
@@ -251,13 +280,6 @@ static void after_write(sicm_plot *p) {
   }
 }
 
-int sicm_plot_point(sicm_plot *p, double x, double y) {
-  enter_operation();
-  int status = add_point(p, x, y);
-  leave_operation();
-  return status;
-}
-
 /* A silent plot keeps nothing but refuses marks once finished, as a real one. */
 static int silent_mark(const sicm_plot *p) {
   if (!p->closed) return 0;
@@ -265,194 +287,75 @@ static int silent_mark(const sicm_plot *p) {
   return -1;
 }
 
-static int add_point(sicm_plot *p, double x, double y) {
-  if (p->silent) return silent_mark(p);
-  mark m = {x, y, NAN, NAN};
-  if (add_mark(p, m) != 0) return -1;
-  write_tsv_number(p->tsv, x);
-  fputc('\t', p->tsv);
-  write_tsv_number(p->tsv, y);
-  fputc('\n', p->tsv);
-  after_write(p);
-  return 0;
+int sicm_plot_point(sicm_plot *p, double x, double y) {
+  return sicm_plot_series_point(p, NULL, x, y);
 }
 
 int sicm_plot_line(sicm_plot *p, double x0, double y0, double x1, double y1) {
+  return sicm_plot_series_line(p, NULL, x0, y0, x1, y1);
+}
+
+int sicm_plot_series_point(sicm_plot *p, const char *series, double x, double y) {
+  const double xs[2] = {x, y};
   enter_operation();
-  int status = add_line(p, x0, y0, x1, y1);
+  int status = add_mark_in(p, series, xs, 2);
   leave_operation();
   return status;
 }
 
-static int add_line(sicm_plot *p, double x0, double y0, double x1, double y1) {
+int sicm_plot_series_line(sicm_plot *p, const char *series, double x0, double y0, double x1,
+                          double y1) {
+  const double xs[4] = {x0, y0, x1, y1};
+  enter_operation();
+  int status = add_mark_in(p, series, xs, 4);
+  leave_operation();
+  return status;
+}
+
+/* Add a point (count 2) or a segment (count 4) to `series` and the TSV. */
+static int add_mark_in(sicm_plot *p, const char *series, const double *xs, size_t count) {
   if (p->silent) return silent_mark(p);
-  mark m = {x0, y0, x1, y1};
+  if (series && !*series) series = NULL; /* "" names no series */
+  const size_t index = find_series(p, series);
+  if (index == SIZE_MAX) return errno = ENOMEM, -1;
+  sicm_plot_mark m = {xs[0], xs[1], count == 4 ? xs[2] : NAN, count == 4 ? xs[3] : NAN, index};
   if (add_mark(p, m) != 0) return -1;
-  write_tsv_number(p->tsv, x0);
-  fputc('\t', p->tsv);
-  write_tsv_number(p->tsv, y0);
-  fputc('\t', p->tsv);
-  write_tsv_number(p->tsv, x1);
-  fputc('\t', p->tsv);
-  write_tsv_number(p->tsv, y1);
+  for (size_t i = 0; i < count; ++i) {
+    if (i) fputc('\t', p->tsv);
+    write_tsv_number(p->tsv, xs[i]);
+  }
+  if (series) write_tsv_name(p->tsv, series);
   fputc('\n', p->tsv);
   after_write(p);
   return 0;
 }
 
-/* ---- the SVG picture ---------------------------------------------------- */
-
-enum { kWidth = 660, kHeight = 480, kLeft = 90, kRight = 20, kTop = 40, kBottom = 50 };
-
-static double px(const sicm_plot *p, double x) {
-  return kLeft + (x - p->xmin) / (p->xmax - p->xmin) * (kWidth - kLeft - kRight);
-}
-static double py(const sicm_plot *p, double y) {
-  return kHeight - kBottom - (y - p->ymin) / (p->ymax - p->ymin) * (kHeight - kTop - kBottom);
-}
-
-/* A "nice" tick spacing: 1, 2 or 5 times a power of ten, about 5-10 ticks. */
-static double tick_step(double span) {
-  double raw = span / 6.0;
-  double mag = pow(10.0, floor(log10(raw)));
-  double f = raw / mag;
-  return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * mag;
+int sicm_plot_style_series(sicm_plot *p, const char *series, double marker_size, int connect) {
+  if (p->silent) return 0;
+  if (series && !*series) series = NULL;
+  enter_operation();
+  const size_t index = find_series(p, series);
+  if (index != SIZE_MAX) {
+    p->series[index].marker_size = marker_size;
+    p->series[index].connect = connect != 0;
+  }
+  leave_operation();
+  return index == SIZE_MAX ? (errno = ENOMEM, -1) : 0;
 }
 
-static void write_escaped(FILE *f, const char *s) {
-  for (; *s; ++s) {
-    switch (*s) {
-    case '<': fputs("&lt;", f); break;
-    case '>': fputs("&gt;", f); break;
-    case '&': fputs("&amp;", f); break;
-    case '"': fputs("&quot;", f); break;
-    default: fputc(*s, f);
-    }
-  }
+int sicm_plot_set_marker_size(sicm_plot *p, double marker_size) {
+  p->marker_size = marker_size;
+  return 0;
 }
 
-/* A tick label: k * step printed with just the digits the step needs
- * (so 0.46, not .4600000000000001), in plain C notation for SVG readers:
- * fixed-point between 1e-4 and 1e6, else compact scientific notation
- * (2e-10, 1.5e7; not 0.0000000002). */
-static void tick_label(char *buf, size_t size, long k, double step) {
-  double value = (double)k * step;
-  if (fabs(value) < step * 1e-9) value = 0.0;
-  if (value != 0 && (step < 1e-4 || fabs(value) >= 1e6)) {
-    /* the digits of value down to the step's decade */
-    int decimals = (int)floor(log10(fabs(value)) + 1e-9) - (int)floor(log10(step) + 1e-9);
-    if (decimals < 0) decimals = 0;
-    if (decimals > 15) decimals = 15;
-    char mantissa[64];
-    snprintf(mantissa, sizeof mantissa, "%.*e", decimals, value);
-    char *e = strchr(mantissa, 'e'); /* 2e-05 -> 2e-5, 1.5e+07 -> 1.5e7 */
-    int exponent = atoi(e + 1);
-    *e = '\0';
-    char exponent_text[16];
-    snprintf(exponent_text, sizeof exponent_text, "e%d", exponent);
-    snprintf(buf, size, "%.32s%s", mantissa, exponent_text);
-    return;
-  }
-  if (value == 0 && step < 1e-4) { /* beside 2e-10, not 0.0000000000 */
-    snprintf(buf, size, "0");
-    return;
-  }
-  int decimals = step >= 1 ? 0 : (int)ceil(-log10(step) - 1e-9);
-  if (decimals > 15) decimals = 15;
-  snprintf(buf, size, "%.*f", decimals, value);
+int sicm_plot_set_equal_aspect(sicm_plot *p, int equal) {
+  p->equal_aspect = equal != 0;
+  return 0;
 }
 
-static void write_ticks(FILE *f, const sicm_plot *p) {
-  char label[64];
-  double step = tick_step(p->xmax - p->xmin);
-  for (long k = (long)ceil(p->xmin / step - 1e-9); k * step <= p->xmax + step * 1e-9; ++k) {
-    double x = px(p, k * step), y0 = kHeight - kBottom;
-    tick_label(label, sizeof label, k, step);
-    fprintf(f, "<line x1=\"%.2f\" y1=\"%d\" x2=\"%.2f\" y2=\"%d\" stroke=\"black\"/>\n", x, (int)y0,
-            x, (int)y0 + 5);
-    fprintf(f, "<text x=\"%.2f\" y=\"%d\" text-anchor=\"middle\">%s</text>\n", x, (int)y0 + 20,
-            label);
-  }
-  step = tick_step(p->ymax - p->ymin);
-  for (long k = (long)ceil(p->ymin / step - 1e-9); k * step <= p->ymax + step * 1e-9; ++k) {
-    double y = py(p, k * step);
-    tick_label(label, sizeof label, k, step);
-    fprintf(f, "<line x1=\"%d\" y1=\"%.2f\" x2=\"%d\" y2=\"%.2f\" stroke=\"black\"/>\n", kLeft - 5,
-            y, kLeft, y);
-    fprintf(f, "<text x=\"%d\" y=\"%.2f\" text-anchor=\"end\">%s</text>\n", kLeft - 8, y + 4,
-            label);
-  }
-}
-
-static int inside(const sicm_plot *p, double x, double y) {
-  return x >= p->xmin && x <= p->xmax && y >= p->ymin && y <= p->ymax;
-}
-
-static void write_marks(FILE *f, const sicm_plot *p) {
-  /* All points as one path of zero-length segments with round caps: small
-   * files and fast rendering even for hundreds of thousands of points. */
-  fputs("<path fill=\"none\" stroke=\"#1f4e99\" stroke-width=\"2\" stroke-linecap=\"round\" d=\"",
-        f);
-  for (size_t i = 0; i < p->n; ++i) {
-    const mark *m = &p->marks[i];
-    if (!isnan(m->x1) || !inside(p, m->x0, m->y0)) continue;
-    fprintf(f, "M%.2f %.2fh0", px(p, m->x0), py(p, m->y0));
-  }
-  fputs("\"/>\n", f);
-  for (size_t i = 0; i < p->n; ++i) {
-    const mark *m = &p->marks[i];
-    if (isnan(m->x1)) continue;
-    fprintf(f,
-            "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#b33\" "
-            "stroke-width=\"1\"/>\n",
-            px(p, m->x0), py(p, m->y0), px(p, m->x1), py(p, m->y1));
-  }
-}
-
-static int write_svg(const sicm_plot *p) {
-  char tmp[4096], final[4096];
-  snprintf(tmp, sizeof tmp, "%s.svg.tmp", p->path);
-  snprintf(final, sizeof final, "%s.svg", p->path);
-  FILE *f = fopen(tmp, "w");
-  if (!f) return -1;
-  fprintf(f,
-          "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-          "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
-          "viewBox=\"0 0 %d %d\" font-family=\"sans-serif\" font-size=\"12\">\n"
-          "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
-          kWidth, kHeight, kWidth, kHeight);
-  fprintf(f, "<text x=\"%d\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">", kWidth / 2);
-  write_escaped(f, p->title);
-  fputs("</text>\n", f);
-  fprintf(f,
-          "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"black\"/>\n",
-          kLeft, kTop, kWidth - kLeft - kRight, kHeight - kTop - kBottom);
-  fprintf(
-      f, "<clipPath id=\"frame\"><rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\"/></clipPath>\n",
-      kLeft, kTop, kWidth - kLeft - kRight, kHeight - kTop - kBottom);
-  write_ticks(f, p);
-  if (p->x_label) {
-    fprintf(f, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">",
-            kLeft + (kWidth - kLeft - kRight) / 2, kHeight - 10);
-    write_escaped(f, p->x_label);
-    fputs("</text>\n", f);
-  }
-  if (p->y_label) {
-    const int x = 16, y = kTop + (kHeight - kTop - kBottom) / 2;
-    fprintf(f, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\" transform=\"rotate(-90 %d %d)\">", x,
-            y, x, y);
-    write_escaped(f, p->y_label);
-    fputs("</text>\n", f);
-  }
-  fputs("<g clip-path=\"url(#frame)\">\n", f);
-  write_marks(f, p);
-  fputs("</g>\n</svg>\n", f);
-  int ok = ferror(f) == 0;
-  if (fclose(f) != 0) ok = 0;
-  if (!ok || rename(tmp, final) != 0) {
-    remove(tmp);
-    return -1;
-  }
+int sicm_plot_set_legend(sicm_plot *p, sicm_plot_legend where) {
+  if ((int)where < 0 || where > SICM_PLOT_LEGEND_NONE) return errno = EINVAL, -1;
+  p->legend = where;
   return 0;
 }
 
@@ -463,7 +366,7 @@ static int finish_plot(sicm_plot *p) {
   int status = 0;
   if (fclose(p->tsv) != 0) status = -1;
   p->tsv = NULL;
-  if (write_svg(p) != 0) status = -1;
+  if (sicm_plot_write_svg(p) != 0) status = -1;
   return status;
 }
 
@@ -481,6 +384,9 @@ void sicm_plot_free(sicm_plot *p) {
   forget(p);
   leave_operation();
   free(p->marks);
+  for (size_t i = 0; i < p->n_series; ++i)
+    free(p->series[i].name);
+  free(p->series);
   free(p->path);
   free(p->title);
   free(p->x_label);

@@ -331,17 +331,43 @@ static void check_open(const sicm_site *site, const sicm_plot *plot, const char 
   if (sicm_plot_is_finished(plot)) sicm_program_fail(site, who, mark_refused);
 }
 
+void sicm_program_plot_options(const sicm_site *site, sicm_plot *plot, int equal_aspect,
+                               double marker_size, int legend) {
+  sicm_plot_set_equal_aspect(plot, equal_aspect);
+  sicm_plot_set_marker_size(plot, marker_size);
+  if (sicm_plot_set_legend(plot, (sicm_plot_legend)legend) != 0)
+    sicm_program_fail(site, "frame", "no such legend position");
+}
+
+void sicm_program_plot_style(const sicm_site *site, sicm_plot *plot, const char *series,
+                             double marker_size, int connect) {
+  if (sicm_plot_style_series(plot, series, marker_size, connect) != 0)
+    sicm_program_fail(site, "plot-series", "out of memory");
+}
+
 void sicm_program_plot_point(const sicm_site *site, sicm_plot *plot, double x, double y) {
-  check_open(site, plot, "plot-point");
-  if (sicm_parallel_log_point(plot, x, y)) return;
-  if (sicm_plot_point(plot, x, y) != 0) sicm_program_fail(site, "plot-point", mark_refused);
+  sicm_program_plot_series_point(site, plot, NULL, x, y);
 }
 
 void sicm_program_plot_line(const sicm_site *site, sicm_plot *plot, double x0, double y0, double x1,
                             double y1) {
+  sicm_program_plot_series_line(site, plot, NULL, x0, y0, x1, y1);
+}
+
+void sicm_program_plot_series_point(const sicm_site *site, sicm_plot *plot, const char *series,
+                                    double x, double y) {
+  check_open(site, plot, "plot-point");
+  if (sicm_parallel_log_point(plot, series, x, y)) return;
+  if (sicm_plot_series_point(plot, series, x, y) != 0)
+    sicm_program_fail(site, "plot-point", mark_refused);
+}
+
+void sicm_program_plot_series_line(const sicm_site *site, sicm_plot *plot, const char *series,
+                                   double x0, double y0, double x1, double y1) {
   check_open(site, plot, "plot-line");
-  if (sicm_parallel_log_line(plot, x0, y0, x1, y1)) return;
-  if (sicm_plot_line(plot, x0, y0, x1, y1) != 0) sicm_program_fail(site, "plot-line", mark_refused);
+  if (sicm_parallel_log_line(plot, series, x0, y0, x1, y1)) return;
+  if (sicm_plot_series_line(plot, series, x0, y0, x1, y1) != 0)
+    sicm_program_fail(site, "plot-line", mark_refused);
 }
 
 /* ---- kernels as the runtime's callbacks -------------------------------------------- */

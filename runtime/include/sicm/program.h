@@ -121,7 +121,7 @@ void sicm_print_boolean(double x);
 double sicm_real_time(void);
 double sicm_run_time(void);
 
-/* (frame xmin xmax ymin ymax [title [x-label y-label]]) and the marks added
+/* (frame xmin xmax ymin ymax [title [x-label y-label]] option ...) and the marks added
  * to it; a plot file that cannot be created or written is a failure at
  * `site`, with the system's reason. NAME is the file name without
  * extension, TITLE may be NULL; the plot directory (--plot-dir) is created
@@ -134,6 +134,21 @@ void sicm_program_plot_labels(const sicm_site *site, sicm_plot *plot, const char
 void sicm_program_plot_point(const sicm_site *site, sicm_plot *plot, double x, double y);
 void sicm_program_plot_line(const sicm_site *site, sicm_plot *plot, double x0, double y0, double x1,
                             double y1);
+/* The frame's options ('aspect 'equal, 'marker-size, 'legend: see
+ * sicm_plot_set_equal_aspect, sicm_plot_set_marker_size and
+ * sicm_plot_set_legend in runtime.h; legend is a sicm_plot_legend). */
+void sicm_program_plot_options(const sicm_site *site, sicm_plot *plot, int equal_aspect,
+                               double marker_size, int legend);
+/* (plot-series window series option ...): how a series is drawn
+ * (sicm_plot_style_series). */
+void sicm_program_plot_style(const sicm_site *site, sicm_plot *plot, const char *series,
+                             double marker_size, int connect);
+/* (plot-point window x y series), (plot-line window x0 y0 x1 y1 series):
+ * marks of a named series (NULL: the unnamed one). */
+void sicm_program_plot_series_point(const sicm_site *site, sicm_plot *plot, const char *series,
+                                    double x, double y);
+void sicm_program_plot_series_line(const sicm_site *site, sicm_plot *plot, const char *series,
+                                   double x0, double y0, double x1, double y1);
 
 /* (definite-integral f a b tol): f's integral over [a, b] to the relative
  * tolerance tol, by adaptive Gauss-Kronrod; when a purely relative tolerance

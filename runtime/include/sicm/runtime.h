@@ -53,8 +53,8 @@ size_t sicm_shortest_digits(char *digits, int *exponent10, double x);
  * A plot is a frame [xmin, xmax] x [ymin, ymax] that collects points and line
  * segments. sicm_plot_open creates DIR/NAME.tsv at once and appends every
  * point to it as it arrives; sicm_plot_finish closes the TSV and writes
- * DIR/NAME.svg (axes, ticks, labels, the marks inside the frame) atomically:
- * to NAME.svg.tmp, then renamed. Every plot still open is finished at exit
+ * DIR/NAME.svg (axes, ticks, labels, the marks inside the frame, a legend)
+ * atomically: to NAME.svg.tmp, then renamed. Every plot still open is finished at exit
  * and on SIGINT/SIGTERM (the process then exits 128+signal), so an
  * interrupted run keeps every point it produced. Functions return 0 on
  * success and -1 with errno set on failure. */
@@ -75,6 +75,42 @@ sicm_plot *sicm_plot_open_silent(const char *name);
 int sicm_plot_set_labels(sicm_plot *p, const char *x_label, const char *y_label);
 int sicm_plot_point(sicm_plot *p, double x, double y);
 int sicm_plot_line(sicm_plot *p, double x0, double y0, double x1, double y1);
+
+/* Series. Every mark belongs to a series: the unnamed one (series NULL,
+ * what sicm_plot_point and sicm_plot_line add to; dark blue points, red
+ * segments) or one named by a non-empty string. A named series gets the
+ * next colour of a ten-colour palette when its first mark arrives, and the
+ * legend lists the named series in that order, so the picture depends only
+ * on the order of the marks. In the TSV a named series' mark has its name
+ * as a last column (tabs and newlines in it written as spaces). */
+int sicm_plot_series_point(sicm_plot *p, const char *series, double x, double y);
+int sicm_plot_series_line(sicm_plot *p, const char *series, double x0, double y0, double x1,
+                          double y1);
+/* How a series (NULL: the unnamed one) is drawn: its points as dots of
+ * marker_size pixels across (0: no dots; negative: the plot's size, below),
+ * and, if connect is non-zero, joined in the order they came by a polyline. */
+int sicm_plot_style_series(sicm_plot *p, const char *series, double marker_size, int connect);
+
+/* Frame options (each may be set any time before the plot is finished). The default dot size, for
+ * every series not styled with its own: marker_size pixels, or (negative, the default) by the
+ * number of points in the plot: 4 below 300 points, 3 below 3000, else 2, so that a sparse section
+ * stays visible and a dense one does not blot. */
+int sicm_plot_set_marker_size(sicm_plot *p, double marker_size);
+/* Equal aspect (non-zero): a unit of x is as long on the page as a unit of
+ * y; the frame is shrunk along one axis and centred. */
+int sicm_plot_set_equal_aspect(sicm_plot *p, int equal);
+/* Where the legend of the named series goes (none without named series):
+ * BEST, the default, is the corner inside the frame where it hides the
+ * fewest marks (top right, top left, bottom right, bottom left on ties). */
+typedef enum {
+  SICM_PLOT_LEGEND_BEST,
+  SICM_PLOT_LEGEND_TOP_RIGHT,
+  SICM_PLOT_LEGEND_TOP_LEFT,
+  SICM_PLOT_LEGEND_BOTTOM_LEFT,
+  SICM_PLOT_LEGEND_BOTTOM_RIGHT,
+  SICM_PLOT_LEGEND_NONE
+} sicm_plot_legend;
+int sicm_plot_set_legend(sicm_plot *p, sicm_plot_legend where);
 /* Whether the plot has been finished (its marks are refused). */
 int sicm_plot_is_finished(const sicm_plot *p);
 /* Number of marks (points and segments) added so far. */
