@@ -16,9 +16,10 @@ dropped, as sicm's `crossings` counts none there.
 
 The integrator is made once (heyoka compiles it with LLVM: "jit s"); each
 round then integrates the ten orbits from their starts, timed in the process
-with time.perf_counter; the median and the min and max of the rounds are
-printed, one line "heyoka tol=... jit_s=... median_s=... min_s=... max_s=...
-points=N". --points FILE writes the points, "orbit t y p_y" per line, for
+with time.perf_counter (and its CPU time with time.process_time); the
+median and the min and max of the rounds are printed, one line "heyoka
+tol=... order=... jit_s=... median_s=... min_s=... max_s=... cpu_s=...
+points=N" (cpu_s the median CPU time of a round). --points FILE writes the points, "orbit t y p_y" per line, for
 bench/sections to compare with its reference. Needs bench/peers/setup.
 """
 import argparse
@@ -77,11 +78,12 @@ def main():
         return orbits
 
     orbits = run()  # warm-up
-    times = []
+    times, cpu = [], []
     for _ in range(a.rounds):
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         run()
         times.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - start_cpu)
     n = sum(len(o) for o in orbits)
     if a.points:
         with open(a.points, "w") as f:
@@ -90,7 +92,7 @@ def main():
                     f.write(f"{i} {t!r} {float(yy)!r} {float(pp)!r}\n")
     print(f"heyoka tol={ta.tol:.3g} order={ta.order} jit_s={jit:.4f} "
           f"median_s={statistics.median(times):.5f} min_s={min(times):.5f} "
-          f"max_s={max(times):.5f} points={n}")
+          f"max_s={max(times):.5f} cpu_s={statistics.median(cpu):.5f} points={n}")
     return 0
 
 
