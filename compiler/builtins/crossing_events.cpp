@@ -21,6 +21,7 @@ namespace {
 std::string name_of(Value proc) {
   if (proc.is(Tag::Closure) && proc.as<Closure>()->lambda->name)
     return proc.as<Closure>()->lambda->name->name;
+  if (proc.is(Tag::Primitive)) return proc.as<Primitive>()->name;
   return proc.is(Tag::Closure) ? "anonymous" : write_string(proc);
 }
 
