@@ -41,7 +41,7 @@ void check_reachable_tolerance(SrcLoc loc, const char *who, const sicm_ode_step_
   runtime_error(loc, what);
 }
 
-void check_monitor_arity(SrcLoc call, const char *who, Value monitor) {
+void check_monitor_arity(SrcLoc call, const char *who, Value monitor, const char *role) {
   if (!monitor.is(Tag::Closure)) return;
   const Lambda *lambda = monitor.as<Closure>()->lambda;
   const uint32_t required = lambda->nrequired, most = required + lambda->noptional;
@@ -52,9 +52,12 @@ void check_monitor_arity(SrcLoc call, const char *who, Value monitor) {
                           : "between " + std::to_string(required) + " and " + std::to_string(most);
   const bool one = !lambda->rest && most == 1 && required == 1;
   SrcLoc at = lambda->loc.known() && !is_library_loc(lambda->loc) ? lambda->loc : call;
-  runtime_error(at, std::string(who) + ": the monitor " + write_string(monitor) + " takes " +
-                        takes + (one ? " argument" : " arguments") + "; " + who +
-                        " calls it with one argument, the state");
+  // An event's procedures are called by the evolve they are given to.
+  const std::string called =
+      std::string(role) == "the monitor" ? std::string(who) + " calls it" : "it is called";
+  runtime_error(at, std::string(who) + ": " + role + " " + write_string(monitor) + " takes " +
+                        takes + (one ? " argument" : " arguments") + "; " + called +
+                        " with one argument, the state");
 }
 
 void taylor_refused(SrcLoc loc, const char *who, const char *method, TaylorRefusal why,

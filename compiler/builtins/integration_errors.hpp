@@ -38,8 +38,10 @@ void check_reachable_tolerance(SrcLoc loc, const char *who, const sicm_ode_step_
 // evolve calls its monitor with one argument, the state: a compound
 // procedure that cannot take one is an error that says it is the monitor,
 // located at the monitor's own definition (the call's `call` when that is
-// not the user's).
-void check_monitor_arity(SrcLoc call, const char *who, Value monitor);
+// not the user's). `role` names what the procedure is ("the monitor",
+// "the event procedure") in the message.
+void check_monitor_arity(SrcLoc call, const char *who, Value monitor,
+                         const char *role = "the monitor");
 
 [[noreturn]] void taylor_refused(SrcLoc loc, const char *who, const char *method, TaylorRefusal why,
                                  const std::string &operation = {});

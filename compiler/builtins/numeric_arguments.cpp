@@ -152,6 +152,10 @@ const std::vector<NumericSignature> &numeric_signatures() {
        4,
        7,
        {R::Any, R::Procedure, R::Direction, R::Finite, R::Tolerance, R::Integrator, R::Count}},
+      // (on-crossing event direction procedure), (stop-on-crossing event direction):
+      // the events evolve and state-advancer take after their other arguments
+      {"on-crossing", 3, 3, {R::Procedure, R::Direction, R::Procedure}},
+      {"stop-on-crossing", 2, 2, {R::Procedure, R::Direction}},
   };
   return table;
 }

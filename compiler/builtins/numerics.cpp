@@ -32,7 +32,6 @@
 
 #include <algorithm>
 #include <cfloat>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -42,18 +41,18 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include "algebra/generic.hpp"
 #include "algebra/structure.hpp"
 #include "base/limits.hpp"
 #include "base/number.hpp"
 #include "base/primitive.hpp"
 #include "builtins/compiled_procedures.hpp"
+#include "builtins/crossing_events.hpp"
 #include "builtins/integration_errors.hpp"
 #include "builtins/integration_sites.hpp"
 #include "builtins/numeric_arguments.hpp"
 #include "builtins/numerics_defaults.hpp"
+#include "builtins/progress_bar.hpp"
 #include "codegen/jit.hpp"
 #include "codegen/kernel.hpp"
 #include "eval/procedure.hpp"
@@ -498,6 +497,113 @@ const sicm_ode_step_type *arg_integrator(Value *a, int n, int i, const char *who
   return integrator_named(symbol_name(a[i])); // a name checked by check_numeric_arguments
 }
 
+// ---- events -------------------------------------------------------------------------
+
+// The event procedure of crossings: a real function of the state, computed
+// by the interpreter (flonums stay flonums), then, once it has been called
+// often enough, by the function sicm build's partial evaluator makes of it
+// (compiled_event), which computes as the interpreter does and as the
+// built program's does: the same numbers either way. And the states at the
+// crossings found.
+struct EventCallback : Callback {
+  Value event;
+  const StateShape *shape;
+  Value sample; // a state of that shape, for compiled_event
+  CompiledFn compiled = nullptr;
+  gcvec<Value> found;
+  size_t most = 0; // stop after this many crossings (0: no limit)
+  EventCallback(SrcLoc l, const char *w, Value e, const StateShape *s, Value state)
+      : Callback(l, w), event(e), shape(s), sample(state) {
+    compiled = compiled_event(event, sample, 0, who);
+  }
+};
+
+double call_event(double, const double *y, void *data) {
+  auto *cb = static_cast<EventCallback *>(data);
+  if (cb->error) return NAN;
+  double value;
+  // A compiled event gives up (1) where the interpreter must compute.
+  if (cb->compiled && cb->compiled(y, &value, interrupt_flag()) == 0) return value;
+  try {
+    Value state = cb->shape->build(y);
+    Value g = apply_procedure(cb->event, &state, 1);
+    if (!cb->compiled) cb->compiled = compiled_event(cb->event, cb->sample, 1, cb->who);
+    if (!is_number(g) || !is_real(g))
+      runtime_error(cb->loc, std::string(cb->who) + ": the event procedure returned " +
+                                 write_string(g) + " for the state " + write_string(state) +
+                                 ", which is not a real number");
+    return to_double(g);
+  } catch (...) {
+    cb->error = std::current_exception();
+    return NAN;
+  }
+}
+
+int record_crossing(size_t, double, const double *y, void *data) {
+  auto *cb = static_cast<EventCallback *>(data);
+  cb->found.push_back(cb->shape->build(y));
+  return cb->most && cb->found.size() >= cb->most; // non-zero: the integration stops here
+}
+
+// The runtime's direction of an event: 'up, 'down or 'both
+// (check_numeric_arguments has checked the symbol).
+int event_direction(Value v) {
+  const std::string &name = symbol_name(v);
+  return name == "up"     ? SICM_ODE_EVENT_UP
+         : name == "down" ? SICM_ODE_EVENT_DOWN
+                          : SICM_ODE_EVENT_BOTH;
+}
+
+// The events given to evolve or state-advancer (on-crossing and
+// stop-on-crossing, builtins/crossing_events.hpp): each event's function
+// computed as crossings' is (EventCallback), and at each crossing, in time
+// order, the event's procedure called with the state there (as a monitor
+// is called), or the integration stopped.
+struct EvolveEvents : Callback {
+  std::vector<std::unique_ptr<EventCallback>> functions; // their Values live in the call's a[]
+  std::vector<const CrossingEvent *> events;
+  std::vector<sicm_ode_event> table;
+  const StateShape *shape;
+  bool stopped = false; // an event stopped the integration
+  EvolveEvents(SrcLoc l, const char *w, Value *a, int n, const StateShape *s, Value state)
+      : Callback(l, w), shape(s) {
+    for (int i = 0; i < n; ++i) {
+      events.push_back(as_crossing_event(a[i]));
+      functions.push_back(std::make_unique<EventCallback>(l, w, events.back()->event, s, state));
+      table.push_back({call_event, functions.back().get(), crossing_direction(*events.back()), 0});
+    }
+  }
+  void attach(sicm_ode *ode);
+  // After the runtime has returned: raise what an event or a procedure raised.
+  void rethrow_all() {
+    for (auto &f : functions)
+      f->rethrow_if_failed();
+    rethrow_if_failed();
+  }
+};
+
+int on_crossing(size_t i, double, const double *y, void *data) {
+  auto *e = static_cast<EvolveEvents *>(data);
+  if (e->error) return 1;
+  if (e->events[i]->stops()) {
+    e->stopped = true;
+    return 1; // non-zero: the integration stops here
+  }
+  try {
+    Value state = e->shape->build(y);
+    apply_procedure(e->events[i]->action, &state, 1);
+    return 0;
+  } catch (...) {
+    e->error = std::current_exception();
+    return 1;
+  }
+}
+
+void EvolveEvents::attach(sicm_ode *ode) {
+  if (!table.empty() && sicm_ode_set_events(ode, table.data(), table.size(), on_crossing, this))
+    numeric_error(loc, who, reason_of(g_runtime_message));
+}
+
 // ---- one integration problem ----------------------------------------------------
 
 // A state, flattened, with its shape and the system derivative's callback.
@@ -591,13 +697,15 @@ struct OdeProblem {
         sicm_ode_step_type_name(T)});
   }
 
-  // Advance the integrator to t1; errors at the call site on failure.
-  void evolve_to(sicm_ode *ode, double &t, double t1) {
+  // Advance the integrator to t1 (to an event's crossing, if one stops it
+  // there); errors at the call site on failure.
+  void evolve_to(sicm_ode *ode, double &t, double t1, EvolveEvents *events = nullptr) {
     const bool timed = sicm_stats_enabled(); // the clock only for --stats
     const double start = timed ? sicm_stats_clock() : 0;
     int status = sicm_ode_evolve(ode, &t, t1, y.data());
     if (timed) seconds += sicm_stats_clock() - start;
     cb.rethrow_if_failed();
+    if (events) events->rethrow_all();
     if (status != SICM_SUCCESS) numeric_error(cb.loc, cb.who, sicm_ode_last_error(ode));
   }
 
@@ -634,10 +742,12 @@ unsigned long optional_max_steps(Value *a, int n, int i) {
   return is_missing(a, n, i) ? 0 : static_cast<unsigned long>(a[i].i);
 }
 
-// ((state-advancer sysder . params) state dt [eps [integrator [max-steps]]]):
-// the state dt later.
-Value advance_state(NativeProc *self, Value *a, int n) {
+// ((state-advancer sysder . params) state dt [eps [integrator [max-steps]]]
+// event ...): the state dt later, or at the crossing of an event that
+// stops it.
+Value advance_state(NativeProc *self, Value *a, int all) {
   static const char who[] = "state-advancer";
+  const int n = arguments_before_events(a, all, who);
   check_numeric_arguments(who, a, n, self);
   SrcLoc loc = current_call_loc();
   double dt = real_at(a, 1);
@@ -650,12 +760,14 @@ Value advance_state(NativeProc *self, Value *a, int n) {
                    recording_integration_sites());
   double t = p.t0, t1 = p.t0 + dt;
   p.record_site(who, t1, eps, T);
+  EvolveEvents events(loc, who, a + n, all - n, &p.shape, a[0]);
   {
     RuntimeErrorScope scope;
     OdePtr ode = p.make_integrator(T, eps, max_steps);
-    p.evolve_to(ode.get(), t, t1);
+    events.attach(ode.get());
+    p.evolve_to(ode.get(), t, t1, &events);
   }
-  return p.state_at(t1);
+  return events.stopped ? p.shape.build(p.y.data()) : p.state_at(t1);
 }
 
 Value P_state_advancer(Value *a, int n) {
@@ -663,45 +775,15 @@ Value P_state_advancer(Value *a, int n) {
                               &g_advancer_lambda);
 }
 
-// A progress bar on stderr for integrations that run longer than a second,
-// drawn only when stderr is a terminal (never in pipes, logs or tests), at
-// most ten times a second, and erased when the integration ends.
-class ProgressBar {
-public:
-  ProgressBar(double t0, double t1) : t0_(t0), t1_(t1), start_(now()), last_(start_) {
-    enabled_ = isatty(2) && t1 != t0;
-  }
-  ~ProgressBar() {
-    if (drawn_) std::fprintf(stderr, "\r%*s\r", 60, "");
-  }
-  void update(double t) {
-    if (!enabled_) return;
-    double s = now();
-    if (s - start_ < 1.0 || s - last_ < 0.1) return;
-    last_ = s;
-    double f = std::clamp((t - t0_) / (t1_ - t0_), 0.0, 1.0);
-    int filled = static_cast<int>(f * 30);
-    std::fprintf(stderr, "\revolve [%.*s%*s] %3d%% t = %.6g", filled,
-                 "==============================", 30 - filled, "", static_cast<int>(f * 100), t);
-    std::fflush(stderr);
-    drawn_ = true;
-  }
-
-private:
-  static double now() {
-    using namespace std::chrono;
-    return duration<double>(steady_clock::now().time_since_epoch()).count();
-  }
-  double t0_, t1_, start_, last_;
-  bool enabled_ = false, drawn_ = false;
-};
-
 // ((evolve sysder . params) state monitor dt final-time [eps [integrator
-// [max-steps]]]):
+// [max-steps]]] event ...):
 // calls (monitor state) at the initial state and every dt until the final
-// time (the last interval is shortened to end there); returns the final state.
-Value run_evolve(NativeProc *self, Value *a, int n) {
+// time (the last interval is shortened to end there), and each event's
+// procedure at its crossings between; returns the final state, or the state
+// at the crossing of an event that stops the integration.
+Value run_evolve(NativeProc *self, Value *a, int all) {
   static const char who[] = "evolve";
+  const int n = arguments_before_events(a, all, who);
   check_numeric_arguments(who, a, n, self);
   SrcLoc loc = current_call_loc();
   check_monitor_arity(loc, who, a[1]);
@@ -724,13 +806,16 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
   sicm_monitor_schedule schedule;
   if (const char *why_not = sicm_monitor_schedule_start(&schedule, p.t0, dt, t_final))
     runtime_error(loc, std::string(who) + ": " + why_not);
+  EvolveEvents events(loc, who, a + n, all - n, &p.shape, a[0]);
   RuntimeErrorScope scope;
   OdePtr ode = p.make_integrator(T, eps, max_steps);
   sicm_ode_set_horizon(ode.get(), t_final);
+  events.attach(ode.get());
   double t = p.t0, tk;
   ProgressBar progress(p.t0, t_final);
   while (sicm_monitor_schedule_next(&schedule, t, &tk)) {
-    p.evolve_to(ode.get(), t, tk);
+    p.evolve_to(ode.get(), t, tk, &events);
+    if (events.stopped) return p.shape.build(p.y.data());
     state = p.state_at(tk);
     apply_procedure(monitor, &state, 1);
     progress.update(tk);
@@ -743,61 +828,6 @@ Value P_evolve(Value *a, int n) {
 }
 
 // ---- crossings ----------------------------------------------------------------------
-
-// The event procedure of crossings: a real function of the state, computed
-// by the interpreter (flonums stay flonums), then, once it has been called
-// often enough, by the function sicm build's partial evaluator makes of it
-// (compiled_event), which computes as the interpreter does and as the
-// built program's does: the same numbers either way. And the states at the
-// crossings found.
-struct EventCallback : Callback {
-  Value event;
-  const StateShape *shape;
-  Value sample; // a state of that shape, for compiled_event
-  CompiledFn compiled = nullptr;
-  gcvec<Value> found;
-  size_t most = 0; // stop after this many crossings (0: no limit)
-  EventCallback(SrcLoc l, const char *w, Value e, const StateShape *s, Value state)
-      : Callback(l, w), event(e), shape(s), sample(state) {
-    compiled = compiled_event(event, sample, 0, who);
-  }
-};
-
-double call_event(double, const double *y, void *data) {
-  auto *cb = static_cast<EventCallback *>(data);
-  if (cb->error) return NAN;
-  double value;
-  // A compiled event gives up (1) where the interpreter must compute.
-  if (cb->compiled && cb->compiled(y, &value, interrupt_flag()) == 0) return value;
-  try {
-    Value state = cb->shape->build(y);
-    Value g = apply_procedure(cb->event, &state, 1);
-    if (!cb->compiled) cb->compiled = compiled_event(cb->event, cb->sample, 1, cb->who);
-    if (!is_number(g) || !is_real(g))
-      runtime_error(cb->loc, std::string(cb->who) + ": the event procedure returned " +
-                                 write_string(g) + " for the state " + write_string(state) +
-                                 ", which is not a real number");
-    return to_double(g);
-  } catch (...) {
-    cb->error = std::current_exception();
-    return NAN;
-  }
-}
-
-int record_crossing(size_t, double, const double *y, void *data) {
-  auto *cb = static_cast<EventCallback *>(data);
-  cb->found.push_back(cb->shape->build(y));
-  return cb->most && cb->found.size() >= cb->most; // non-zero: the integration stops here
-}
-
-// The runtime's direction of an event: 'up, 'down or 'both
-// (check_numeric_arguments has checked the symbol).
-int event_direction(Value v) {
-  const std::string &name = symbol_name(v);
-  return name == "up"     ? SICM_ODE_EVENT_UP
-         : name == "down" ? SICM_ODE_EVENT_DOWN
-                          : SICM_ODE_EVENT_BOTH;
-}
 
 // ((crossings sysder . params) state event direction t-final [eps [integrator
 // [count]]]): the states where (event state) crosses 0 in direction between

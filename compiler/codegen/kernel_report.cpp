@@ -137,6 +137,10 @@ void find_uses(const std::vector<RStmt> &body, std::map<int, Use> &uses) {
     for (int member : s.members)
       note(member, "other"); // a member of parallel-map
     note(s.monitor, "monitor");
+    for (const REvent &e : s.events) {
+      note(e.event, "other"); // the event function of on-crossing or stop-on-crossing
+      note(e.action, "monitor");
+    }
     note(s.jacobian, "jacobian");
     note(s.probe, "other"); // what the derivative divides by, evaluated only on failure
     find_uses(s.then_body, uses);

@@ -114,31 +114,41 @@ struct RPlotOptions {
   bool connect = false;      // PlotStyle
 };
 
+// An event of an Advance or Evolve (on-crossing, stop-on-crossing): where
+// function `event` of the state crosses 0 in `direction`, function `action`
+// is called with the state there, or, when it is -1, the integration stops.
+struct REvent {
+  int event = -1;
+  int direction = 0; // SICM_ODE_EVENT_UP, _DOWN or _BOTH
+  int action = -1;
+};
+
 struct RStmt {
   explicit RStmt(RKind k) : kind(k) {}
   RKind kind;
   RCompute compute = RCompute::Expr;
   std::vector<ExprId> args;
-  std::vector<int> outs;    // variable ids defined by the statement
-  std::vector<int> results; // Loop, Break: the loop's result variables
-  int var = -1;             // Let, Print
-  int plot = -1;            // plot statements: the plot's number
-  int callee = -1;          // the function a numerical statement calls
-  int monitor = -1;         // Evolve: the monitor function, or -1; Crossings: the event
-  int direction = 0;        // Crossings: SICM_ODE_EVENT_UP, _DOWN or _BOTH
-  int first_monitor = -1;   // Evolve: the monitor for the initial state as written (exact
-                            // numbers), or -1: monitor
-  std::vector<int> members; // ParallelMap: the members' functions (one for all, or one each)
-  int count = 0;            // ParallelMap: the number of members; Crossings: the most, 0: all
-  int jacobian = -1;        // Advance, Evolve: (D sysder) for implicit methods
-  int probe = -1;           // Advance, Evolve: what sysder divides by, or -1
-  int cell = -1;            // SetCell, Let of ReadCell
-  int list = -1;            // ListNew, ListPush, Let of ListLength, ListRef, ListFold
-  int leaf = 0;             // Let of ListRef, ListFold; ListConst: the table
-  bool backward = false;    // Let of ListFold
-  bool as_list = false;     // Multimin: the start point is a list (not a vector), for messages
-  double number = 0;        // a tolerance
-  long max_steps = 0;       // Advance, Evolve: steps per output time, 0 for the runtime's default
+  std::vector<int> outs;      // variable ids defined by the statement
+  std::vector<int> results;   // Loop, Break: the loop's result variables
+  int var = -1;               // Let, Print
+  int plot = -1;              // plot statements: the plot's number
+  int callee = -1;            // the function a numerical statement calls
+  int monitor = -1;           // Evolve: the monitor function, or -1; Crossings: the event
+  int direction = 0;          // Crossings: SICM_ODE_EVENT_UP, _DOWN or _BOTH
+  int first_monitor = -1;     // Evolve: the monitor for the initial state as written (exact
+                              // numbers), or -1: monitor
+  std::vector<int> members;   // ParallelMap: the members' functions (one for all, or one each)
+  std::vector<REvent> events; // Advance, Evolve: their events, in the order written
+  int count = 0;              // ParallelMap: the number of members; Crossings: the most, 0: all
+  int jacobian = -1;          // Advance, Evolve: (D sysder) for implicit methods
+  int probe = -1;             // Advance, Evolve: what sysder divides by, or -1
+  int cell = -1;              // SetCell, Let of ReadCell
+  int list = -1;              // ListNew, ListPush, Let of ListLength, ListRef, ListFold
+  int leaf = 0;               // Let of ListRef, ListFold; ListConst: the table
+  bool backward = false;      // Let of ListFold
+  bool as_list = false;       // Multimin: the start point is a list (not a vector), for messages
+  double number = 0;          // a tolerance
+  long max_steps = 0;         // Advance, Evolve: steps per output time, 0 for the runtime's default
   bool time_first = false, rate_one = false; // Advance, Evolve
   std::string method;                        // Advance, Evolve: the runtime's step type variable
   std::string text, title;

@@ -356,6 +356,17 @@ private:
     }
     callee(s.first_monitor, "first monitor", true);
     require(s.first_monitor == -1 || s.monitor >= 0, "has a first monitor but no monitor");
+    require(s.kind != RKind::Crossings || s.events.empty(), "crossings has events");
+    for (const REvent &e : s.events) {
+      callee(e.event, "event", false);
+      const RFunction &event = p_.functions[static_cast<size_t>(e.event)];
+      require(event.inputs.size() == dim && event.outputs.size() == 1,
+              "its event f" + std::to_string(e.event) + " is not a number of the state");
+      callee(e.action, "event's procedure", true);
+      require(e.action == -1 || p_.functions[static_cast<size_t>(e.action)].inputs.size() == dim,
+              "its event's procedure f" + std::to_string(e.action) + " does not take the state");
+      require(e.direction >= 1 && e.direction <= 3, "has an event without a direction");
+    }
     // A kernel (emitted as plain C, as sicm run's JIT kernels) is one DAG.
     for (int k : {s.callee, s.jacobian, s.probe})
       if (k >= 0)

@@ -104,6 +104,11 @@ private:
     add("probe", s.probe);
     for (int m : s.members)
       c += " member f" + std::to_string(m);
+    static const char *const directions[] = {"", "up", "down", "both"};
+    for (const REvent &e : s.events)
+      c += " event f" + std::to_string(e.event) + " " +
+           directions[e.direction >= 1 && e.direction <= 3 ? e.direction : 0] +
+           (e.action >= 0 ? " calls f" + std::to_string(e.action) : std::string(" stops"));
     return c;
   }
 

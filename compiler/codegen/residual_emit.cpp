@@ -308,6 +308,9 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
         if (callee >= 0) needs.insert(captures_[callee].begin(), captures_[callee].end());
       for (int member : s.members)
         needs.insert(captures_[member].begin(), captures_[member].end());
+      for (const REvent &e : s.events)
+        for (int callee : {e.event, e.action})
+          if (callee >= 0) needs.insert(captures_[callee].begin(), captures_[callee].end());
       live.insert(needs.begin(), needs.end());
       used.insert(needs.begin(), needs.end());
     }
@@ -729,7 +732,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
   }
 
   // Advance's operands are the state then dt; Evolve's the state, dt and
-  // the final time.
+  // the final time. With events, the *_events driver, given them in a table.
   std::string advance_or_evolve(int f, const RStmt &s, const std::string &prefix) {
     std::string code;
     std::vector<std::string> a = operands(s.args, prefix, s.loc, code);
@@ -737,13 +740,23 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     size_t dim = a.size() - extra;
     std::string y = prefix + "y";
     code += "double " + y + "[] = {" + join({a.begin(), a.begin() + dim}) + "};\n";
+    std::string events;
+    if (!s.events.empty()) {
+      code += "const sicm_drive_event " + prefix + "events[] = {";
+      for (size_t i = 0; i < s.events.size(); ++i)
+        code += std::string(i ? ", " : "") + "{" + closure(s.events[i].event) + ", " +
+                std::to_string(s.events[i].direction) + ", " + closure(s.events[i].action) + "}";
+      code += "};\n";
+      events = ", " + prefix + "events, " + std::to_string(s.events.size());
+    }
+    const char *suffix = s.events.empty() ? "(" : "_events(";
     if (s.kind == RKind::Advance)
-      code += "sicm_drive_advance(" + site(s.loc) + ", &" + ode(s, dim) + ", " + y + ", " + a[dim] +
-              ");\n";
+      code += "sicm_drive_advance" + std::string(suffix) + site(s.loc) + ", &" + ode(s, dim) +
+              ", " + y + ", " + a[dim] + events + ");\n";
     else
-      code += "sicm_drive_evolve(" + site(s.loc) + ", &" + ode(s, dim) + ", " +
+      code += "sicm_drive_evolve" + std::string(suffix) + site(s.loc) + ", &" + ode(s, dim) + ", " +
               closure(s.first_monitor >= 0 ? s.first_monitor : s.monitor) + ", " +
-              closure(s.monitor) + ", " + y + ", " + a[dim] + ", " + a[dim + 1] + ");\n";
+              closure(s.monitor) + ", " + y + ", " + a[dim] + ", " + a[dim + 1] + events + ");\n";
     code += unpack(f, s.outs, y);
     return code;
   }

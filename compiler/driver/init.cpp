@@ -59,6 +59,7 @@ void init_interpreter() {
   install_literal_function_primitives();
   install_series_primitives();
   install_numerics_primitives();
+  install_crossing_event_primitives();
   install_kernel_primitives();
   install_parameter_primitives();
   install_effect_primitives();

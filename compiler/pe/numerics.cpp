@@ -18,6 +18,7 @@
 #include "base/limits.hpp"
 #include "base/number.hpp"
 #include "base/primitive.hpp"
+#include "builtins/crossing_events.hpp"
 #include "builtins/integration_errors.hpp"
 #include "builtins/numeric_arguments.hpp"
 #include "builtins/numerics.hpp"
@@ -785,8 +786,29 @@ Value sysder_of(Value *a, int n, const char *who) {
   return apply_procedure(a[0], a + 1, n - 1);
 }
 
-Value advance(NativeProc *self, Value *a, int n) {
+// The events after the other arguments (on-crossing, stop-on-crossing,
+// a[n .. all)): each event traced as crossings' is, each procedure as a
+// monitor is, into functions the statement calls at run time.
+void trace_events(Value *a, int n, int all, Value state, RStmt &s, const char *who) {
+  for (int i = n; i < all; ++i) {
+    const CrossingEvent *e = as_crossing_event(a[i]);
+    reset_call_loc(s.loc); // the traces before moved it into their procedures
+    REvent r;
+    r.event = trace_event_function(e->event, state, who);
+    r.direction = crossing_direction(*e);
+    if (!e->stops()) {
+      FunctionScope scope(procedure_name(e->action));
+      Value x = input_like(state);
+      apply_procedure(e->action, &x, 1);
+      r.action = scope.id();
+    }
+    s.events.push_back(r);
+  }
+}
+
+Value advance(NativeProc *self, Value *a, int all) {
   static const char who[] = "state-advancer";
+  const int n = arguments_before_events(a, all, who);
   check_numeric_arguments(who, a, n, self);
   RStmt s{RKind::Advance};
   s.loc = here();
@@ -800,6 +822,7 @@ Value advance(NativeProc *self, Value *a, int n) {
   check_taylor(s, who);
   trace_singular_factors(a[0], s);
   trace_jacobian(self->a, a[0], s);
+  trace_events(a, n, all, a[0], s, who);
   Value r = state_result(a[0], s);
   emit(std::move(s));
   return r;
@@ -810,8 +833,9 @@ Value P_state_advancer(Value *a, int n) {
                     &g_build->advancer_lambda);
 }
 
-Value run_evolve(NativeProc *self, Value *a, int n) {
+Value run_evolve(NativeProc *self, Value *a, int all) {
   static const char who[] = "evolve";
+  const int n = arguments_before_events(a, all, who);
   check_numeric_arguments(who, a, n, self);
   check_monitor_arity(here(), who, a[1]);
   Checkpoint before; // for a monitor whose trace fails (below)
@@ -856,6 +880,7 @@ Value run_evolve(NativeProc *self, Value *a, int n) {
     apply_procedure(monitor, &x, 1);
     s.first_monitor = scope.id();
   }
+  trace_events(a, n, all, a[0], s, who);
   Value r = state_result(a[0], s);
   emit(std::move(s));
   return r;

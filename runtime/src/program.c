@@ -596,18 +596,72 @@ static double start_time(const sicm_drive_ode *ode, const double *y) {
   return ode->time_first && isfinite(y[0]) ? y[0] : 0.0;
 }
 
+/* The events of an evolve or a state advance, and whether one stopped it. */
+typedef struct {
+  const sicm_drive_event *events;
+  int stopped;
+} event_sink;
+
+static double drive_event_of(double t, const double *y, void *c) {
+  (void)t;
+  const sicm_drive_event *e = c;
+  double out;
+  e->event.fn(y, &out, e->event.p);
+  return out;
+}
+
+static int on_drive_event(size_t i, double t, const double *y, void *c) {
+  (void)t;
+  event_sink *sink = c;
+  const sicm_drive_event *e = &sink->events[i];
+  if (!e->action.fn) {
+    sink->stopped = 1;
+    return 1; /* non-zero: stop here */
+  }
+  e->action.fn(y, NULL, e->action.p);
+  return 0;
+}
+
+/* Give the integrator its events (none: it integrates as without). */
+static void set_drive_events(const sicm_site *site, const char *who, integrator *it,
+                             const sicm_drive_event *events, size_t n, event_sink *sink) {
+  sink->events = events;
+  sink->stopped = 0;
+  if (n == 0) return;
+  sicm_ode_event *table = malloc(n * sizeof *table);
+  if (!table) sicm_program_fail(site, who, "out of memory");
+  for (size_t i = 0; i < n; ++i)
+    table[i] = (sicm_ode_event){drive_event_of, (void *)&events[i], events[i].direction, 0};
+  const int status = sicm_ode_set_events(it->o, table, n, on_drive_event, sink);
+  free(table); /* sicm_ode_set_events copied it */
+  if (status) fail_with_status(site, who);
+}
+
 void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double *y, double dt) {
+  sicm_drive_advance_events(site, ode, y, dt, NULL, 0);
+}
+
+void sicm_drive_advance_events(const sicm_site *site, const sicm_drive_ode *ode, double *y,
+                               double dt, const sicm_drive_event *events, size_t n) {
   static const char who[] = "state-advancer";
   integrator it;
   open_integrator(site, who, ode, &it);
+  event_sink sink;
+  set_drive_events(site, who, &it, events, n, &sink);
   double t = start_time(ode, y), t1 = t + dt;
   evolve_to(site, who, &it, &t, t1, y);
-  if (ode->time_first && ode->rate_one) y[0] = t1;
+  if (ode->time_first && ode->rate_one && !sink.stopped) y[0] = t1;
   close_integrator(&it);
 }
 
 void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure first,
                        sicm_closure monitor, double *y, double dt, double t_final) {
+  sicm_drive_evolve_events(site, ode, first, monitor, y, dt, t_final, NULL, 0);
+}
+
+void sicm_drive_evolve_events(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure first,
+                              sicm_closure monitor, double *y, double dt, double t_final,
+                              const sicm_drive_event *events, size_t n) {
   static const char who[] = "evolve";
   const double t0 = start_time(ode, y);
   if (first.fn) first.fn(y, NULL, first.p);
@@ -619,16 +673,19 @@ void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_cl
   integrator it;
   open_integrator(site, who, ode, &it);
   sicm_ode_set_horizon(it.o, t_final);
+  event_sink sink;
+  set_drive_events(site, who, &it, events, n, &sink);
   double t = t0, tk;
   while (sicm_monitor_schedule_next(&schedule, t, &tk)) {
     evolve_to(site, who, &it, &t, tk, y);
+    if (sink.stopped) break;
     if (monitor.fn) {
       memcpy(shown, y, ode->dim * sizeof *shown);
       if (ode->time_first && ode->rate_one) shown[0] = tk;
       monitor.fn(shown, NULL, monitor.p);
     }
   }
-  if (ode->time_first && ode->rate_one) y[0] = t_final;
+  if (ode->time_first && ode->rate_one && !sink.stopped) y[0] = t_final;
   close_integrator(&it);
   free(shown);
 }

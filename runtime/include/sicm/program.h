@@ -211,6 +211,27 @@ typedef struct {
  * later. */
 void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double *y, double dt);
 
+/* An event of evolve or state-advancer, (on-crossing event direction
+ * procedure) or (stop-on-crossing event direction): event, a kernel of the
+ * state giving one number, crosses 0 in direction (SICM_ODE_EVENT_UP, _DOWN
+ * or _BOTH of sicm/ode.h), located as crossings locates it; at each
+ * crossing action, a kernel of the state with no outputs, is called with
+ * the state there, or, when action's fn is NULL, the integration stops
+ * there. */
+typedef struct {
+  sicm_closure event;
+  int direction;
+  sicm_closure action;
+} sicm_drive_event;
+
+/* sicm_drive_advance with n events (sicm_drive_advance is this with none):
+ * their actions are called in time order on the way; y becomes the state dt
+ * later, or the state at the crossing of an event that stops the
+ * integration (its time, the first leaf when the state has one, tells
+ * which). */
+void sicm_drive_advance_events(const sicm_site *site, const sicm_drive_ode *ode, double *y,
+                               double dt, const sicm_drive_event *events, size_t n);
+
 /* ((evolve ...) state monitor dt t-final tol): calls first (a kernel of
  * the state, NULL fn for none) at the initial state, then monitor every dt
  * until t-final (the last interval shortened to end there:
@@ -220,6 +241,14 @@ void sicm_drive_advance(const sicm_site *site, const sicm_drive_ode *ode, double
  * run). */
 void sicm_drive_evolve(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure first,
                        sicm_closure monitor, double *y, double dt, double t_final);
+
+/* sicm_drive_evolve with n events (sicm_drive_evolve is this with none):
+ * their actions are called in time order among the monitor's calls; an
+ * event that stops the integration leaves y at its crossing, and the
+ * monitor is called no more. */
+void sicm_drive_evolve_events(const sicm_site *site, const sicm_drive_ode *ode, sicm_closure first,
+                              sicm_closure monitor, double *y, double dt, double t_final,
+                              const sicm_drive_event *events, size_t n);
 
 /* ---- parallel-map and parallel-for-each (parallel.c) ----
  *
