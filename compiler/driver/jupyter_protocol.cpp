@@ -30,8 +30,8 @@ JupyterRequest read_jupyter_request(std::FILE *in) {
   if (space == std::string::npos) return {};
   char *end = nullptr;
   unsigned long long n = std::strtoull(header.c_str() + space + 1, &end, 10);
-  if (*end != '\0' || n > kMaxRequestBytes) return {};
-  JupyterRequest r{header.substr(0, space), std::string(n, '\0')};
+  if ((*end != '\0' && *end != ' ') || n > kMaxRequestBytes) return {};
+  JupyterRequest r{header.substr(0, space), std::string(n, '\0'), *end ? end + 1 : ""};
   if (n && std::fread(r.text.data(), 1, n, in) != n) return {};
   return r;
 }

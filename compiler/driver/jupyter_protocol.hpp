@@ -1,10 +1,12 @@
 // The protocol of `sicm repl --kernel`: how a Jupyter kernel (jupyter/
 // sicm_kernel.py) talks to one sicm session over its stdin and stdout.
 //
-// Requests, on stdin: a header line "VERB LENGTH" and then exactly LENGTH
-// bytes of UTF-8 text (no terminator needed):
-//   execute N   the text is a cell: every form is read, then evaluated in order
-//   complete N  the text is the start of a name: the bound names it begins
+// Requests, on stdin: a header line "VERB LENGTH [NAME]" and then exactly
+// LENGTH bytes of UTF-8 text (no terminator needed):
+//   execute N [NAME]  the text is a cell: every form is read, then evaluated
+//                     in order; NAME (no spaces; default <cell-K>, the K-th
+//                     cell) is how errors name the cell: In[3]:2:5
+//   complete N        the text is the start of a name: the bound names it begins
 //
 // Replies, on stdout: one JSON object per line, each with a "type":
 //   {"type":"ready"}                                    once, at start
@@ -37,6 +39,7 @@ namespace sicm {
 struct JupyterRequest {
   std::string verb; // "execute", "complete"; "" at end of input
   std::string text;
+  std::string name; // "" when the header gives none
 };
 
 // The next request on `in`; verb "" at end of input or on a malformed header.

@@ -199,8 +199,8 @@ bool run_form(const ReadForm &form, uint32_t file, bool last) {
   return ok;
 }
 
-void execute(const std::string &code, int cell) {
-  uint32_t file = register_source("<cell-" + std::to_string(cell) + ">", code);
+void execute(const std::string &code, const std::string &name) {
+  uint32_t file = register_source(name, code);
   std::vector<ReadForm> forms;
   try {
     Reader reader(file);
@@ -283,7 +283,8 @@ int run_jupyter_session(const JupyterOptions &options) {
   int cell = 0;
   for (JupyterRequest r; !(r = read_jupyter_request(stdin)).verb.empty();) {
     if (r.verb == "execute") {
-      execute(r.text, ++cell);
+      ++cell;
+      execute(r.text, r.name.empty() ? "<cell-" + std::to_string(cell) + ">" : r.name);
     } else if (r.verb == "complete") {
       write_jupyter_message(g_out, json_object({{"type", json_string("matches")},
                                                 {"matches", json_strings(completions(r.text))}}));
