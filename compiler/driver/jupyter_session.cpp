@@ -201,7 +201,7 @@ bool run_form(const ReadForm &form, uint32_t file, bool last) {
 
 void execute(const std::string &code, const std::string &name) {
   uint32_t file = register_source(name, code);
-  std::vector<ReadForm> forms;
+  gcvec<ReadForm> forms; // GC memory: the data must live until their turn
   try {
     Reader reader(file);
     for (ReadForm form; reader.next(form);)
