@@ -28,7 +28,6 @@ import queue
 import shutil
 import signal
 import subprocess
-import tempfile
 import threading
 
 from ipykernel.kernelbase import Kernel
@@ -45,9 +44,10 @@ class Session:
     """One `sicm repl --kernel` process and the queue of what it writes."""
 
     def __init__(self):
-        self.plot_dir = tempfile.mkdtemp(prefix="sicm-kernel-")
+        # The session writes its plots into a directory of its own, which it
+        # removes when its stdin closes, even if this process was killed.
         self.proc = subprocess.Popen(
-            [sicm_binary(), "repl", "--kernel", "--plot-dir", self.plot_dir],
+            [sicm_binary(), "repl", "--kernel"],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
             start_new_session=True)
         self.replies = queue.Queue()
@@ -88,7 +88,6 @@ class Session:
         except (OSError, subprocess.TimeoutExpired):
             self.proc.kill()
             self.proc.wait()
-        shutil.rmtree(self.plot_dir, ignore_errors=True)
 
 
 class SicmKernel(Kernel):
