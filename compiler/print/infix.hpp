@@ -46,7 +46,6 @@ std::string datum_to_tex(Value datum);
 
 // The dot notation above, for every rendering after the call.
 void set_dot_notation(bool on);
-bool dot_notation();
 
 // (->tex-string v): v in TeX, as shown (builtins/show.cpp).
 std::string value_to_tex(Value v);

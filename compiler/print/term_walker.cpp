@@ -51,10 +51,6 @@ void set_dot_notation(bool on) {
   g_dot_notation = on;
 }
 
-bool dot_notation() {
-  return g_dot_notation;
-}
-
 // The dot notation's name for (head t), or "" when it does not apply
 // (print/infix.hpp): (theta t) -> theta, ((D theta) t) -> thetadot.
 std::string TermWalker::dotted(Value head, const gcvec<Value> &args) {
