@@ -111,7 +111,10 @@ class SicmKernel(Kernel):
 
     def do_execute(self, code, silent, store_history=True, user_expressions=None,
                    allow_stdin=False):
-        self.sicm.send("execute", code, f"In[{self.execution_count}]")
+        try:
+            self.sicm.send("execute", code, f"In[{self.execution_count}]")
+        except OSError:  # it ended after the last cell
+            return self._restart_session("the session had ended")
         error = None
         interrupted = False
         while True:
@@ -164,11 +167,15 @@ class SicmKernel(Kernel):
         return reply
 
     def _restart_session(self, why):
-        status = self.sicm.proc.poll()
-        self.sicm.proc.kill()
+        """Replace the session by a new one and fail the cell saying why."""
+        proc = self.sicm.proc
+        try:
+            why += f" (exit status {proc.wait(timeout=1)})"
+        except subprocess.TimeoutExpired:  # it lives on, stuck: end it
+            proc.kill()
         self.sicm.close()
         self.sicm = Session()
-        text = f"{why} (exit status {status}); a new session was started: definitions are lost"
+        text = f"{why}; a new session was started: definitions are lost"
         msg = {"ename": "SessionRestarted", "evalue": text, "traceback": [text],
                "line": 0, "col": 0}
         self.send_response(self.iopub_socket, "error", msg)

@@ -262,6 +262,19 @@ void remove_plot_dir(const std::string &dir) {
   rmdir(dir.c_str());
 }
 
+bool g_own_plot_dir = false;
+
+// At exit, however it comes (end of input, or (exit) in a cell): the output
+// not sent yet, and the plot directory if we made it. Registered after the
+// plot library's own exit handler, so it runs first: the plots still open
+// are finished here, into the directory, before it goes.
+void end_session() {
+  send_output();
+  set_output_hook(nullptr);
+  sicm_plot_close_all();
+  if (g_own_plot_dir) remove_plot_dir(g_plot_dir);
+}
+
 } // namespace
 
 int run_jupyter_session(const JupyterOptions &options) {
@@ -269,14 +282,15 @@ int run_jupyter_session(const JupyterOptions &options) {
     std::perror("sicm repl --kernel: stdout");
     return 1;
   }
-  bool own_dir = options.plot_dir.empty();
-  g_plot_dir = own_dir ? make_plot_dir() : options.plot_dir;
+  g_plot_dir = options.plot_dir.empty() ? make_plot_dir() : options.plot_dir;
   if (g_plot_dir.empty()) {
     std::perror("sicm repl --kernel: cannot make a directory for plots");
     return 1;
   }
   set_plot_directory(g_plot_dir);
   take_sigint();
+  g_own_plot_dir = options.plot_dir.empty();
+  std::atexit(end_session); // also when a cell calls (exit)
   set_output_hook(collect_output);
   set_dot_notation(true);
   write_jupyter_message(g_out, json_object({{"type", json_string("ready")}}));
@@ -291,9 +305,6 @@ int run_jupyter_session(const JupyterOptions &options) {
     }
     send_done();
   }
-  set_output_hook(nullptr);
-  sicm_plot_close_all();
-  if (own_dir) remove_plot_dir(g_plot_dir);
   return 0;
 }
 
