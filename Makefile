@@ -13,6 +13,9 @@
 #                   run it, and write its plot into build/figures
 #   make fuzz-differential  random programs run and built, compared byte for
 #                   byte (SEED=1 COUNT=500 JOBS=1; fuzz/README.md)
+#   make jupyter    install the Jupyter kernel `sicm` (and ipykernel) where the
+#                   jupyter on PATH looks: the active virtual environment, else
+#                   a project one, build/jupyter-venv (jupyter/install says how)
 #   make install    install sicm under $(PREFIX)
 #   make clean
 #
@@ -74,7 +77,7 @@ UNITBIN := $(BUILD)/unit-tests
 MPILIB  := $(if $(MPICC),$(BUILD)/libsicmrt_mpi.a)
 MPI_OBJS := $(if $(MPICC),$(BUILD)/runtime/mpi/parallel_mpi.o)
 
-.PHONY: all check demo examples stability accuracy effects install clean deps unit fuzz-smoke fuzz-differential
+.PHONY: jupyter all check demo examples stability accuracy effects install clean deps unit fuzz-smoke fuzz-differential
 all: $(SICM) $(RTLIB) $(MPILIB)
 
 $(BUILD)/%.o: %.cpp
@@ -163,10 +166,17 @@ SANENV := $(if $(SANITIZE),\
 
 # FUZZ=0 leaves out the short fuzz runs (and the clang build they need).
 FUZZ ?= 1
+# The Python that runs the Jupyter kernel's tests (tests/jupyter/run): Debian's,
+# which has the packages scripts/install-deps installs (python3-ipykernel,
+# python3-jupyter-client, python3-nbclient, python3-nbformat), whatever
+# python3 comes first on PATH (a pyenv one, say). JUPYTER_PYTHON= (empty)
+# leaves those tests out.
+JUPYTER_PYTHON ?= /usr/bin/python3
 check: deps
 	@$(MAKE) --no-print-directory all $(UNITBIN)
 	@$(SANENV) python3 tests/run --sicm $(SICM) --unit $(UNITBIN) $(if $(UPDATE),--update) \
-	  --differential scripts/fuzz-differential $(if $(filter 1,$(FUZZ)),--fuzz scripts/fuzz)
+	  --differential scripts/fuzz-differential $(if $(filter 1,$(FUZZ)),--fuzz scripts/fuzz) \
+	  $(if $(JUPYTER_PYTHON),--jupyter $(JUPYTER_PYTHON))
 
 demo: deps
 	@$(MAKE) --no-print-directory all
@@ -211,6 +221,11 @@ JOBS ?= 1
 fuzz-differential: deps
 	@$(MAKE) --no-print-directory all
 	@scripts/fuzz-differential --sicm $(SICM) --seed $(SEED) --count $(COUNT) --jobs $(JOBS)
+
+# The kernel spec `sicm` and what the kernel needs (jupyter/install).
+jupyter: deps
+	@$(MAKE) --no-print-directory all
+	@jupyter/install
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include/sicm

@@ -58,15 +58,29 @@ Value P_to_infix(Value *a, int) {
 }
 
 Value P_to_tex_string(Value *a, int) {
-  return make_string(datum_to_tex(show_datum(a[0])));
+  return make_string(value_to_tex(a[0]));
+}
+
+// (set-dot-notation! on): time derivatives with dots in show-expression,
+// ->infix and ->tex-string from now on (print/infix.hpp).
+Value P_set_dot_notation(Value *a, int) {
+  set_dot_notation(!a[0].is_false());
+  return Value::unspecified();
 }
 
 } // namespace
+
+std::string value_to_tex(Value v) {
+  return datum_to_tex(show_datum(v));
+}
 
 void install_show_primitives() {
   define_primitive("show-expression", 1, 1, Stage::Effect, P_show_expression);
   define_primitive("->infix", 1, 1, Stage::Pure, P_to_infix);
   define_primitive("->tex-string", 1, 1, Stage::Pure, P_to_tex_string);
+  // Pure: its effect is on how values print, which sicm build does while
+  // compiling, in program order.
+  define_primitive("set-dot-notation!", 1, 1, Stage::Pure, P_set_dot_notation);
 }
 
 } // namespace sicm

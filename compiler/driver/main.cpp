@@ -22,6 +22,7 @@
 #include "builtins/plot.hpp"
 #include "codegen/kernel.hpp"
 #include "driver/init.hpp"
+#include "driver/jupyter_session.hpp"
 #include "driver/pipeline.hpp"
 #include "driver/repl.hpp"
 #include "driver/run_check.hpp"
@@ -91,6 +92,9 @@ const char kUsage[] =
     "                            tolerance: DIR/work-precision.tsv and .svg (default\n"
     "                            DIR: FILE-bench; tolerances 1e-3:1e-14 by decades)\n"
     "       sicm repl            interactive read-eval-print loop\n"
+    "       sicm repl --kernel [--plot-dir DIR]\n"
+    "                            the session of a Jupyter kernel: requests on stdin,\n"
+    "                            JSON replies on stdout (driver/jupyter_protocol.hpp)\n"
     "       sicm --version\n"
     "run, build, emit-c, emit-kernels and repl also take the limit flags\n"
     "--max-steps, --max-memory, --max-expression-nodes, --max-recursion-depth,\n"
@@ -181,6 +185,25 @@ int bench(const std::vector<std::string> &args) {
 }
 
 int dispatch(const std::vector<std::string> &args) {
+  if (!args.empty() && args[0] == "repl" && args.size() > 1) {
+    sicm::JupyterOptions k;
+    bool kernel = false;
+    for (size_t i = 1; i < args.size(); ++i) {
+      if (args[i] == "--kernel") {
+        kernel = true;
+      } else if (args[i] == "--plot-dir" && i + 1 < args.size()) {
+        k.plot_dir = args[++i];
+      } else {
+        std::fputs(kUsage, stderr);
+        return kExitUsage;
+      }
+    }
+    if (!kernel) {
+      std::fputs(kUsage, stderr);
+      return kExitUsage;
+    }
+    return sicm::run_jupyter_session(k);
+  }
   if (args.empty() || args[0] == "repl") {
     sicm::ReplOptions opts;
     opts.interactive = isatty(0) && isatty(1);

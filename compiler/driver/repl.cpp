@@ -266,21 +266,10 @@ const char *const kKeywords[] = {
 std::vector<std::string> g_matches;
 size_t g_next_match = 0;
 
-// The library's internal helpers are named %...: offered only to a user who
-// types the %.
-std::vector<std::string> names_starting_with(std::string_view prefix) {
-  std::set<std::string> names;
-  for (const std::string &n : global_names())
-    if (n.starts_with(prefix) && (!n.starts_with("%") || prefix.starts_with("%"))) names.insert(n);
-  for (const char *k : kKeywords)
-    if (std::string_view(k).starts_with(prefix)) names.insert(k);
-  return {names.begin(), names.end()};
-}
-
 // readline's generator protocol: state 0 starts a new completion.
 char *next_match(const char *text, int state) {
   if (state == 0) {
-    g_matches = names_starting_with(text);
+    g_matches = completions(text);
     g_next_match = 0;
   }
   if (g_next_match >= g_matches.size()) return nullptr;
@@ -465,6 +454,17 @@ int repl_loop(LineSource read_line, bool interactive) {
 }
 
 } // namespace
+
+// The library's internal helpers are named %...: offered only to a user who
+// types the %.
+std::vector<std::string> completions(std::string_view prefix) {
+  std::set<std::string> names;
+  for (const std::string &n : global_names())
+    if (n.starts_with(prefix) && (!n.starts_with("%") || prefix.starts_with("%"))) names.insert(n);
+  for (const char *k : kKeywords)
+    if (std::string_view(k).starts_with(prefix)) names.insert(k);
+  return {names.begin(), names.end()};
+}
 
 int run_repl(const ReplOptions &options) {
   if (!options.interactive || !open_wake_pipe()) return repl_loop(read_piped_line, false);

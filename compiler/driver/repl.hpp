@@ -2,6 +2,8 @@
 #pragma once
 
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace sicm {
 
@@ -14,5 +16,11 @@ struct ReplOptions {
 // their values MIT style, until end of input. Call after init_interpreter(),
 // on the evaluator thread. Returns the exit status (0).
 int run_repl(const ReplOptions &options);
+
+// The names a completion of `prefix` offers, sorted: those bound in the
+// global environment and the special-form keywords (the library's %-helpers
+// only when the prefix starts with %). Tab in the REPL, complete requests
+// of `sicm repl --kernel`.
+std::vector<std::string> completions(std::string_view prefix);
 
 } // namespace sicm

@@ -24,6 +24,15 @@
 // f\left(t\right), \dot{\theta}, p_{x}, D^{2}x\left(t\right), \partial_{1,0},
 // \sqrt{x}, up as \begin{pmatrix} a \\ b \end{pmatrix}, down as
 // \begin{bmatrix} a & b \end{bmatrix}, matrices as bmatrix rows.
+//
+// Dot notation (off unless set_dot_notation(true); `sicm repl --kernel` and
+// (set-dot-notation! #t) turn it on, for both renderings): a function of
+// time applied to the symbol t is written as the book's typeset equations
+// write it, without the argument and with a dot per time derivative:
+// ((D theta) t) -> θ̇ / \dot{\theta}, (((expt D 2) theta) t) -> θ̈ /
+// \ddot{\theta}, (theta t) -> θ / \theta. Only a literal function's name is
+// shortened, never sin(t) and its kind, and only up to three dots; other
+// derivatives keep their D.
 #pragma once
 
 #include <string>
@@ -34,6 +43,12 @@ namespace sicm {
 
 std::string datum_to_infix(Value datum);
 std::string datum_to_tex(Value datum);
+
+// The dot notation above, for every rendering after the call.
+void set_dot_notation(bool on);
+
+// (->tex-string v): v in TeX, as shown (builtins/show.cpp).
+std::string value_to_tex(Value v);
 
 // show-expression, ->infix, ->tex-string (builtins/show.cpp).
 

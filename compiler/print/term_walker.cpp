@@ -8,6 +8,62 @@ namespace sicm {
 
 using namespace expr_shape;
 
+namespace {
+
+bool g_dot_notation = false;
+
+// Functions of the numbers, whose argument the dot notation always shows.
+bool is_elementary_function(const std::string &name) {
+  static const char *const kNames[] = {"sin",    "cos",  "tan",    "cot",  "sec",       "csc",
+                                       "exp",    "log",  "sinh",   "cosh", "tanh",      "asin",
+                                       "acos",   "atan", "sqrt",   "abs",  "arcsin",    "arccos",
+                                       "arctan", "cube", "square", "expt", "magnitude", "angle"};
+  for (const char *n : kNames)
+    if (name == n) return true;
+  return false;
+}
+
+// f with n time derivatives as a name the name printers show with dots:
+// theta -> thetadot, p_x -> pdot_x (the dots belong to the base).
+std::string dotted_name(const std::string &f, int n) {
+  size_t base_end = f.find_first_of("_^");
+  if (base_end == std::string::npos) base_end = f.size();
+  std::string dots;
+  for (int i = 0; i < n; ++i)
+    dots += "dot";
+  return f.substr(0, base_end) + dots + f.substr(base_end);
+}
+
+// How many times op differentiates: D -> 1, (expt D n) -> n; 0 for any
+// other operator (a partial derivative).
+int time_derivatives(Value op) {
+  if (is_symbol(op)) return symbol_name(op) == "D" ? 1 : 0;
+  if (head_is(op, "expt") && list_length(op) == 3 && is_symbol(car(cdr(op))) &&
+      symbol_name(car(cdr(op))) == "D" && car(cdr(cdr(op))).is(Tag::Fixnum) &&
+      car(cdr(cdr(op))).i >= 1 && car(cdr(cdr(op))).i <= 3)
+    return static_cast<int>(car(cdr(cdr(op))).i);
+  return 0;
+}
+
+} // namespace
+
+void set_dot_notation(bool on) {
+  g_dot_notation = on;
+}
+
+// The dot notation's name for (head t), or "" when it does not apply
+// (print/infix.hpp): (theta t) -> theta, ((D theta) t) -> thetadot.
+std::string TermWalker::dotted(Value head, const gcvec<Value> &args) {
+  if (!g_dot_notation || args.size() != 1 || !is_symbol(args[0]) || symbol_name(args[0]) != "t")
+    return "";
+  if (is_symbol(head)) return is_elementary_function(symbol_name(head)) ? "" : symbol_name(head);
+  if (!is_operator_application(head)) return "";
+  Value op = car(head), f = car(cdr(head));
+  int n = time_derivatives(op);
+  if (!is_symbol(f) || n < 1 || n > 3 || is_elementary_function(symbol_name(f))) return "";
+  return dotted_name(symbol_name(f), n);
+}
+
 std::string TermWalker::wrap(const Text &t, int min, bool paren_neg) {
   if (t.prec < min || (paren_neg && t.neg)) return paren(t.s);
   return t.s;
@@ -82,6 +138,7 @@ TermWalker::Text TermWalker::operator_application(Value op, Value f) {
 
 // f(a, b), Dx(t), (f + g)(t).
 TermWalker::Text TermWalker::application(Value head, const gcvec<Value> &args) {
+  if (std::string name = dotted(head, args); !name.empty()) return {name_text(name), kAtom};
   std::string h =
       is_symbol(head) ? function_text(symbol_name(head)) : wrap(render(head), kAtom, true);
   return {h + paren(join(args, ", ")), kAtom};

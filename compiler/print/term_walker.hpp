@@ -68,6 +68,7 @@ private:
   Text product(Value d, const gcvec<Value> &args);
   Text operator_application(Value op, Value f);
   Text application(Value head, const gcvec<Value> &args);
+  std::string dotted(Value head, const gcvec<Value> &args);
   Text render_list(Value d);
 };
 
