@@ -854,7 +854,10 @@ Value run_crossings(NativeProc *self, Value *a, int n) {
     const sicm_ode_event event = {call_event, &events, direction, 0};
     sicm_ode_set_events(ode.get(), &event, 1, record_crossing, &events);
     double t = p.t0;
+    const bool timed = sicm_stats_enabled(); // the clock only for --stats
+    const double start = timed ? sicm_stats_clock() : 0;
     const int status = sicm_ode_evolve(ode.get(), &t, t_final, p.y.data());
+    if (timed) p.seconds += sicm_stats_clock() - start;
     p.cb.rethrow_if_failed();
     events.rethrow_if_failed();
     if (status != SICM_SUCCESS) numeric_error(loc, who, sicm_ode_last_error(ode.get()));
