@@ -413,10 +413,13 @@ private:
 
   std::string assemble(const std::string &c_name) {
     const size_t n = t_.inputs.size();
-    std::string outs;
+    // c_{k+1} = f_k / (k + 1): one division for the whole order, each
+    // component a multiplication by its reciprocal (a division costs as
+    // much as a dozen multiplications, and there is one per component).
+    std::string outs = "    const " + real_ + " reciprocal = (" + real_ + ")1 / (k + 1);\n";
     for (size_t i = 0; i < n; ++i)
       outs += "    c[(k + 1) * " + std::to_string(n) + " + " + std::to_string(i) +
-              "] = " + coefficient_k(t_.outputs[i]) + " / (k + 1);\n";
+              "] = " + coefficient_k(t_.outputs[i]) + " * reciprocal;\n";
     std::string f = "void " + c_name + "(const " + real_ + " *in, int order, " + real_ +
                     " *c, const double *p) {\n";
     f += "  (void)p;\n";

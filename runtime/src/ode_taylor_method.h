@@ -21,9 +21,10 @@
 
 typedef struct {
   int order;
-  REAL *c;    /* (order + 1) * dim: the expansion at the start of the step in hand */
-  REAL *y;    /* the method's own state, at time t */
-  REAL *comp; /* its rounding error, carried (compensated summation) */
+  double safety; /* exp(-0.7 / (order - 1)), the step's factor */
+  REAL *c;       /* (order + 1) * dim: the expansion at the start of the step in hand */
+  REAL *y;       /* the method's own state, at time t */
+  REAL *comp;    /* its rounding error, carried (compensated summation) */
   REAL t;
   REAL t0;       /* the step in hand covers [t0, t] (have_step) */
   int have_step; /* c holds the expansion at t0 */
@@ -37,6 +38,7 @@ static int NAME(init)(sicm_ode *o) {
   if (!s) return SICM_ENOMEM;
   o->backend = s;
   s->order = taylor_order(o);
+  s->safety = exp(-0.7 / (s->order - 1));
   s->c = malloc((size_t)(s->order + 1) * o->dim * sizeof *s->c);
   s->y = malloc(o->dim * sizeof *s->y);
   s->comp = malloc(o->dim * sizeof *s->comp);
@@ -65,15 +67,18 @@ static void NAME(free)(sicm_ode *o) {
  * rho_k = max_i |c_k,i| / (abs_tol + rel_tol |y_i|). */
 static double NAME(step_for)(const sicm_ode *o, const NAME(state) * s) {
   const int p = s->order;
-  double h = INFINITY;
-  for (int k = p - 1; k <= p; k++) {
-    const REAL *ck = s->c + (size_t)k * o->dim;
-    double rho = 0;
-    for (size_t i = 0; i < o->dim; i++)
-      rho = fmax(rho, (double)(FABS(ck[i]) / (o->abs_tol + o->rel_tol * FABS(s->y[i]))));
-    if (rho > 0) h = fmin(h, pow(rho, -1.0 / k));
+  const REAL *c1 = s->c + (size_t)(p - 1) * o->dim, *c2 = s->c + (size_t)p * o->dim;
+  double rho1 = 0, rho2 = 0;
+  for (size_t i = 0; i < o->dim; i++) {
+    /* One division a component for both orders. */
+    const REAL weight = 1 / (o->abs_tol + o->rel_tol * FABS(s->y[i]));
+    rho1 = fmax(rho1, (double)(FABS(c1[i]) * weight));
+    rho2 = fmax(rho2, (double)(FABS(c2[i]) * weight));
   }
-  return h * exp(-0.7 / (p - 1));
+  double h = INFINITY;
+  if (rho1 > 0) h = pow(rho1, -1.0 / (p - 1));
+  if (rho2 > 0) h = fmin(h, pow(rho2, -1.0 / p));
+  return h * s->safety;
 }
 
 static int NAME(finite)(size_t n, const REAL *v) {
