@@ -1,9 +1,15 @@
-# Reference for henon-heiles-section-50-orbits.sicm: the first 100 upward
-# crossings of x = 0 by the Henon-Heiles orbit through (y, p_y) = (0.1, 0.05)
-# on the section at E = 1/8, by mpmath's Taylor-series ODE solver at 30
-# digits, each crossing bracketed on a grid of 0.25 time units and found by
-# mpmath's root finder. Prints time, y, p_y per crossing. Takes some minutes.
+# Reference for henon-heiles-section-50-orbits.sicm (100 crossings) and
+# tests/numerics/section-henon-heiles.sicm (5): the first N upward crossings
+# of x = 0 by the Henon-Heiles orbit through (y, p_y) = (0.1, 0.05) on the
+# section at E = 1/8, by mpmath's Taylor-series ODE solver at 30 digits, each
+# crossing bracketed on a grid of 0.25 time units and found by mpmath's root
+# finder. Prints time, y, p_y per crossing. Usage: python3 THIS [N], N = 100
+# by default (some minutes).
+import sys
+
 import mpmath as mp
+
+count = int(sys.argv[1]) if len(sys.argv) > 1 else 100
 
 mp.mp.dps = 30
 E = mp.mpf(1) / 8
@@ -15,7 +21,7 @@ f = mp.odefun(lambda t, s: [s[2], s[3], -s[0] - 2 * s[0] * s[1], -s[1] - s[0]**2
 x = lambda t: f(t)[0]
 times = []
 t, step = mp.mpf(0), mp.mpf('0.25')
-while len(times) < 100:
+while len(times) < count:
     a, b = t, t + step
     if x(a) < 0 <= x(b):
         times.append(mp.findroot(x, (a, b), solver='anderson'))
