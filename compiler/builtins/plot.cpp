@@ -110,7 +110,9 @@ Value P_graphics_close(Value *a, int) {
 }
 
 Value P_graphics_clear(Value *a, int) {
-  arg_window(a, 0, "graphics-clear");
+  PlotWindow *w = arg_window(a, 0, "graphics-clear");
+  if (sicm_plot_clear(w->plot) != 0)
+    runtime_error(current_call_loc(), "graphics-clear: the plot is closed or memory is exhausted");
   return Value::unspecified();
 }
 

@@ -77,6 +77,7 @@ enum class RKind : uint8_t {
   PlotPoint,   // plot-point plot args[0] args[1] [series]
   PlotLine,    // plot-line plot args[0..3] [series]
   PlotStyle,   // plot-series plot series: its marker size and connect in `plot_options`
+  Clear,       // graphics-clear plot
   Close,       // graphics-close plot
   SetCell,     // cell `cell` = args[0]
   If,          // if (args[0] != 0) then_body else else_body

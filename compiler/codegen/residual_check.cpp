@@ -233,6 +233,7 @@ private:
       args(s, 0);
       plot(s);
       break;
+    case RKind::Clear:
     case RKind::Close: plot(s); break;
     case RKind::SetCell:
       args(s, 1);

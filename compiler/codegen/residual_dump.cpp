@@ -177,6 +177,7 @@ const char *statement_kind_name(RKind k) {
   case RKind::PlotLine: return "plot-line";
   case RKind::PlotStyle: return "plot-series";
   case RKind::Close: return "graphics-close";
+  case RKind::Clear: return "graphics-clear";
   case RKind::SetCell: return "set-cell";
   case RKind::If: return "if";
   case RKind::Loop: return "loop";

@@ -503,6 +503,8 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
     case RKind::PlotLine: return plot_line(s, prefix);
     case RKind::PlotStyle: return plot_style(s);
     case RKind::Close: return "sicm_plot_finish(plot" + std::to_string(s.plot) + ");\n";
+    case RKind::Clear:
+      return "sicm_program_plot_clear(" + site(s.loc) + ", plot" + std::to_string(s.plot) + ");\n";
     case RKind::SetCell: return set_cell(s, prefix);
     case RKind::ListNew: return list_new(s);
     case RKind::ListPush: return list_push(s, prefix);
@@ -846,6 +848,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       case RKind::Crossings:
       case RKind::Frame:
       case RKind::PlotStyle:
+      case RKind::Clear:
       case RKind::Close: return true;
       default: break;
       }

@@ -100,7 +100,10 @@ Value P_graphics_close(Value *a, int) {
 }
 
 Value P_graphics_clear(Value *a, int) {
-  arg_plot(a, 0, "graphics-clear");
+  RStmt s{RKind::Clear};
+  s.loc = here();
+  s.plot = arg_plot(a, 0, "graphics-clear")->id;
+  emit(std::move(s));
   return Value::unspecified();
 }
 

@@ -94,12 +94,13 @@ void sicm_parallel_failing(void) {
 
 /* ---- logs ------------------------------------------------------------------ */
 
-enum { kText = 'T', kPoint = 'P', kLine = 'L' };
+enum { kText = 'T', kPoint = 'P', kLine = 'L', kClear = 'C' };
 
 /* A record: its tag, then for kText a uint64 length and the bytes, for
  * kPoint a uint64 plot reference, the series' name (a uint64 length, 0 for
  * the unnamed series, and the bytes) and x, y, for kLine the reference, the
- * name and x0, y0, x1, y1. Fields are unaligned (memcpy). Consecutive texts
+ * name and x0, y0, x1, y1, for kClear the reference and an empty name.
+ * Fields are unaligned (memcpy). Consecutive texts
  * are merged. */
 typedef struct {
   unsigned char *bytes;
@@ -215,6 +216,12 @@ int sicm_parallel_log_line(sicm_plot *plot, const char *series, double x0, doubl
   return 1;
 }
 
+int sicm_parallel_log_clear(sicm_plot *plot) {
+  if (!running) return 0;
+  log_mark(kClear, plot, NULL, NULL, 0);
+  return 1;
+}
+
 void sicm_parallel_member_failed(char *message) {
   if (!running) return;
   running->m->error = message;
@@ -251,7 +258,7 @@ static void walk_log(const sicm_site *site, unsigned char *bytes, size_t len, in
     }
     at += (size_t)name_len;
     double xs[4];
-    const size_t count = tag == kPoint ? 2 : 4;
+    const size_t count = tag == kPoint ? 2 : tag == kLine ? 4 : 0;
     memcpy(xs, bytes + at, count * sizeof *xs);
     at += count * sizeof *xs;
     if (!replay) {
@@ -263,7 +270,9 @@ static void walk_log(const sicm_site *site, unsigned char *bytes, size_t len, in
     }
     sicm_plot *plot = numbered ? (v == UINT64_MAX ? NULL : sicm_program_frame_at((size_t)v))
                                : (sicm_plot *)(uintptr_t)v;
-    if (plot && tag == kPoint)
+    if (plot && tag == kClear)
+      sicm_program_plot_clear(site, plot);
+    else if (plot && tag == kPoint)
       sicm_program_plot_series_point(site, plot, series, xs[0], xs[1]);
     else if (plot)
       sicm_program_plot_series_line(site, plot, series, xs[0], xs[1], xs[2], xs[3]);

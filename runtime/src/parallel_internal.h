@@ -27,6 +27,7 @@ int sicm_parallel_log_text(const char *s, size_t len);
 int sicm_parallel_log_point(sicm_plot *plot, const char *series, double x, double y);
 int sicm_parallel_log_line(sicm_plot *plot, const char *series, double x0, double y0, double x1,
                            double y1);
+int sicm_parallel_log_clear(sicm_plot *plot);
 
 /* When the calling thread runs a member of a buffered sweep, record
  * `message` (sicm_program_fail's whole stderr text, malloc'd, which the

@@ -370,6 +370,27 @@ static int finish_plot(sicm_plot *p) {
   return status;
 }
 
+int sicm_plot_clear(sicm_plot *p) {
+  if (p->closed) {
+    errno = EINVAL;
+    return -1;
+  }
+  enter_operation();
+  p->n = 0;
+  p->points = 0;
+  p->ranked = 0;
+  for (size_t i = 0; i < p->n_series; ++i) {
+    p->series[i].points = 0;
+    if (p->series[i].name) p->series[i].rank = -1;
+  }
+  if (p->tsv) {
+    fputs("# cleared\n", p->tsv);
+    after_write(p);
+  }
+  leave_operation();
+  return 0;
+}
+
 int sicm_plot_finish(sicm_plot *p) {
   enter_operation();
   int status = finish_plot(p);

@@ -345,6 +345,12 @@ void sicm_program_plot_style(const sicm_site *site, sicm_plot *plot, const char 
     sicm_program_fail(site, "plot-series", "out of memory");
 }
 
+void sicm_program_plot_clear(const sicm_site *site, sicm_plot *plot) {
+  check_open(site, plot, "graphics-clear");
+  if (sicm_parallel_log_clear(plot)) return;
+  if (sicm_plot_clear(plot) != 0) sicm_program_fail(site, "graphics-clear", mark_refused);
+}
+
 void sicm_program_plot_point(const sicm_site *site, sicm_plot *plot, double x, double y) {
   sicm_program_plot_series_point(site, plot, NULL, x, y);
 }

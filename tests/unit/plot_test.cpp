@@ -114,3 +114,35 @@ TEST(Plot, TinyTicksAreCompactAndAxesAreLabelled) {
   EXPECT_NE(svg.find(">t (s)</text>"), std::string::npos);
   EXPECT_NE(svg.find(">x&lt;y</text>"), std::string::npos);
 }
+
+// graphics-clear: the picture keeps only what comes after the clear: its
+// SVG is that of a plot that had only those marks (the segment and the
+// named series before it gone, the legend's colours given anew); the TSV
+// logs every mark and the clear; a finished plot refuses it.
+TEST(Plot, ClearDropsEarlierMarksFromThePicture) {
+  std::string dir = temp_dir();
+  sicm_plot *p = sicm_plot_open(dir.c_str(), "c", "a plot", 0, 10, 0, 10);
+  sicm_plot *fresh = sicm_plot_open(dir.c_str(), "fresh", "a plot", 0, 10, 0, 10);
+  ASSERT_NE(p, nullptr);
+  ASSERT_NE(fresh, nullptr);
+  ASSERT_EQ(sicm_plot_line(p, 1, 1, 9, 9), 0);
+  ASSERT_EQ(sicm_plot_series_point(p, "before", 2, 2), 0);
+  EXPECT_EQ(sicm_plot_count(p), 2u);
+  ASSERT_EQ(sicm_plot_clear(p), 0);
+  EXPECT_EQ(sicm_plot_count(p), 0u);
+  ASSERT_EQ(sicm_plot_series_point(p, "after", 5, 5), 0);
+  ASSERT_EQ(sicm_plot_series_point(fresh, "after", 5, 5), 0);
+  ASSERT_EQ(sicm_plot_finish(p), 0);
+  ASSERT_EQ(sicm_plot_finish(fresh), 0);
+  EXPECT_EQ(sicm_plot_clear(p), -1);
+  std::string svg = slurp(dir + "/c.svg");
+  EXPECT_EQ(svg, slurp(dir + "/fresh.svg"));
+  EXPECT_EQ(svg.find("before"), std::string::npos);
+  std::string tsv = slurp(dir + "/c.tsv");
+  const size_t cleared = tsv.find("# cleared\n");
+  ASSERT_NE(cleared, std::string::npos);
+  EXPECT_LT(tsv.find("before"), cleared);
+  EXPECT_GT(tsv.find("after"), cleared);
+  sicm_plot_free(p);
+  sicm_plot_free(fresh);
+}

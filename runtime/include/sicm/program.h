@@ -132,6 +132,9 @@ sicm_plot *sicm_program_frame(const sicm_site *site, const char *name, const cha
 void sicm_program_plot_labels(const sicm_site *site, sicm_plot *plot, const char *x_label,
                               const char *y_label);
 void sicm_program_plot_point(const sicm_site *site, sicm_plot *plot, double x, double y);
+/* (graphics-clear window): sicm_plot_clear; in a member of a sweep, in its
+ * place among the member's marks. */
+void sicm_program_plot_clear(const sicm_site *site, sicm_plot *plot);
 void sicm_program_plot_line(const sicm_site *site, sicm_plot *plot, double x0, double y0, double x1,
                             double y1);
 /* The frame's options ('aspect 'equal, 'marker-size, 'legend: see

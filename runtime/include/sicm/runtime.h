@@ -111,6 +111,12 @@ typedef enum {
   SICM_PLOT_LEGEND_NONE
 } sicm_plot_legend;
 int sicm_plot_set_legend(sicm_plot *p, sicm_plot_legend where);
+/* Remove every mark plotted so far (graphics-clear): the picture shows only
+ * the marks added after it, the named series lose their colours and legend
+ * rows until their next mark, styles and frame options stay. The TSV, a
+ * log of the marks in order, gets the line "# cleared" there. -1 (errno
+ * EINVAL) once the plot is finished. */
+int sicm_plot_clear(sicm_plot *p);
 /* Whether the plot has been finished (its marks are refused). */
 int sicm_plot_is_finished(const sicm_plot *p);
 /* Number of marks (points and segments) added so far. */
