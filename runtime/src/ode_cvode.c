@@ -27,6 +27,7 @@ typedef struct {
   SUNContext ctx;
   void *mem;
   N_Vector y;
+  N_Vector dense;         /* CVodeGetDky's output, for cv_dense */
   SUNMatrix A;            /* BDF only */
   SUNLinearSolver ls;     /* BDF only */
   SUNNonlinearSolver nls; /* Adams only */
@@ -85,8 +86,9 @@ static int cv_init(sicm_ode *o) {
   const size_t n = o->dim;
   if (SUNContext_Create(NULL, &b->ctx) != 0) return SICM_EFAILED;
   b->y = N_VNew_Serial((sunindextype)n, b->ctx);
+  b->dense = N_VNew_Serial((sunindextype)n, b->ctx);
   b->mem = CVodeCreate(is_bdf(o) ? CV_BDF : CV_ADAMS, b->ctx);
-  if (!b->y || !b->mem) return SICM_ENOMEM;
+  if (!b->y || !b->dense || !b->mem) return SICM_ENOMEM;
   N_VConst(0.0, b->y);
   int s = CVodeInit(b->mem, cv_rhs, 0.0, b->y);
   s = s ? s : CVodeSetErrHandlerFn(b->mem, cv_error_handler, b);
@@ -117,6 +119,7 @@ static void cv_free(sicm_ode *o) {
   if (b->ls) SUNLinSolFree(b->ls);
   if (b->A) SUNMatDestroy(b->A);
   if (b->y) N_VDestroy(b->y);
+  if (b->dense) N_VDestroy(b->dense);
   if (b->ctx) SUNContext_Free(&b->ctx);
   free(b->jac);
   free(b->dfdt);
@@ -205,9 +208,30 @@ static int cv_evolve(sicm_ode *o, double *t, double t1, double *y) {
   return SICM_SUCCESS;
 }
 
+/* CVODE's own continuous output (the step type's dense): the
+ * interpolating polynomial of its last internal step, as accurate as the
+ * step, when that step spans [ta, tb] (an evolve to tb stops there: the
+ * stop time), so that events are located on it, as on a Taylor step. */
+static int cv_dense(sicm_ode *o, double ta, double tb, double s, double *y) {
+  cv_backend *b = o->backend;
+  if (b->need_reinit) return SICM_EINVAL;
+  sunrealtype tn = 0, hu = 0;
+  if (CVodeGetCurrentTime(b->mem, &tn) || CVodeGetLastStep(b->mem, &hu) || tn != tb ||
+      fabs((tn - hu) - ta) > 4 * DBL_EPSILON * fmax(fabs(ta), fabs(tb)))
+    return SICM_EINVAL;
+  if (!y) return SICM_SUCCESS;
+  /* Within the step: ta + s may round a hair outside it. */
+  double t = ta + s;
+  const double lo = fmin(tn - hu, tn), hi = fmax(tn - hu, tn);
+  t = fmin(fmax(t, lo), hi);
+  if (CVodeGetDky(b->mem, t, 0, b->dense)) return SICM_EINVAL;
+  memcpy(y, N_VGetArrayPointer(b->dense), o->dim * sizeof *y);
+  return SICM_SUCCESS;
+}
+
 static const int kAdams = CV_ADAMS, kBdf = CV_BDF;
 
 const sicm_ode_step_type sicm_ode_cvode_adams_type = {"cvode-adams", cv_init, cv_evolve, cv_reset,
-                                                      cv_free,       &kAdams, NULL};
+                                                      cv_free,       &kAdams, cv_dense};
 const sicm_ode_step_type sicm_ode_cvode_bdf_type = {"cvode-bdf", cv_init, cv_evolve, cv_reset,
-                                                    cv_free,     &kBdf,   NULL};
+                                                    cv_free,     &kBdf,   cv_dense};
