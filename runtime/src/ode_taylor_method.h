@@ -62,22 +62,26 @@ static void NAME(free)(sicm_ode *o) {
 }
 
 /* The step size the coefficients allow (positive; INFINITY when the series
- * ends before order p - 1, as for a polynomial solution): Jorba and Zou's
+ * ends before order p - 1, as for a polynomial solution; NaN when a
+ * coefficient of the last two orders is not finite): Jorba and Zou's
  * h = min over k = p-1, p of rho_k^(-1/k), times exp(-0.7/(p-1)), where
  * rho_k = max_i |c_k,i| / (abs_tol + rel_tol |y_i|). */
 static double NAME(step_for)(const sicm_ode *o, const NAME(state) * s) {
   const int p = s->order;
   const REAL *c1 = s->c + (size_t)(p - 1) * o->dim, *c2 = s->c + (size_t)p * o->dim;
-  double rho1 = 0, rho2 = 0;
+  REAL rho1 = 0, rho2 = 0;
   for (size_t i = 0; i < o->dim; i++) {
     /* One division a component for both orders. */
     const REAL weight = 1 / (o->abs_tol + o->rel_tol * FABS(s->y[i]));
-    rho1 = fmax(rho1, (double)(FABS(c1[i]) * weight));
-    rho2 = fmax(rho2, (double)(FABS(c2[i]) * weight));
+    const REAL r1 = FABS(c1[i]) * weight, r2 = FABS(c2[i]) * weight;
+    /* Not fmax, a call that drops NaN: these comparisons keep it. */
+    rho1 = r1 > rho1 || r1 != r1 ? r1 : rho1;
+    rho2 = r2 > rho2 || r2 != r2 ? r2 : rho2;
   }
+  if (!isfinite(rho1) || !isfinite(rho2)) return NAN;
   double h = INFINITY;
-  if (rho1 > 0) h = pow(rho1, -1.0 / (p - 1));
-  if (rho2 > 0) h = fmin(h, pow(rho2, -1.0 / p));
+  if (rho1 > 0) h = pow((double)rho1, -1.0 / (p - 1));
+  if (rho2 > 0) h = fmin(h, pow((double)rho2, -1.0 / p));
   return h * s->safety;
 }
 
@@ -94,6 +98,17 @@ static void NAME(report)(const sicm_ode *o, const NAME(state) * s, double *t, do
   *t = (double)s->t;
 }
 
+/* The failure of a step whose coefficients or new state are not finite,
+ * reported at the own state (the start of the step). */
+static int NAME(fail_non_finite)(sicm_ode *o, NAME(state) * s, double *t, double *y) {
+  NAME(report)(o, s, t, y);
+  if (!NAME(finite)((size_t)(s->order + 1) * o->dim, s->c))
+    return sicm_ode_fail(o, SICM_EBADFUNC, *t, y, "non-finite derivative",
+                         "the Taylor coefficients of the solution are NaN or infinite here");
+  return sicm_ode_fail(o, SICM_EBADFUNC, *t, y, "non-finite state",
+                       "a Taylor step gave NaN or infinite components");
+}
+
 /* One step from the own state (t, y) towards `limit`: expand, choose h,
  * advance. Returns SICM_SUCCESS or a failure (reported at the own state). */
 static int NAME(step)(sicm_ode *o, NAME(state) * s, REAL limit, double *t, double *y) {
@@ -102,13 +117,14 @@ static int NAME(step)(sicm_ode *o, NAME(state) * s, REAL limit, double *t, doubl
   s->have_step = 0;
   COEFFICIENTS(s->y, p, s->c, o->taylor_params);
   o->stats.rhs_evals++;
-  if (!NAME(finite)((size_t)(p + 1) * dim, s->c)) {
-    NAME(report)(o, s, t, y);
-    return sicm_ode_fail(o, SICM_EBADFUNC, *t, y, "non-finite derivative",
-                         "the Taylor coefficients of the solution are NaN or infinite here");
-  }
+  /* The coefficients are not checked one by one here: a non-finite one
+   * makes the step size NaN (the last two orders) or the new state
+   * non-finite (the others, through Horner's sums), and only then are they
+   * looked at, to say which. */
+  const double h_series = NAME(step_for)(o, s);
+  if (h_series != h_series) return NAME(fail_non_finite)(o, s, t, y);
   const REAL dir = limit > s->t ? 1 : -1;
-  REAL h = dir * NAME(step_for)(o, s);
+  REAL h = dir * h_series;
   /* The step the series allows, even when this one is cut short at the
    * limit: a caller that chooses its own spans (events: ode_events.c) asks
    * for the next one as long. */
@@ -120,6 +136,7 @@ static int NAME(step)(sicm_ode *o, NAME(state) * s, REAL limit, double *t, doubl
    * ulp of t a step (3e-14 over ten periods of an oscillator). */
   if (!final) h = (s->t + h) - s->t;
   if (s->t + h == s->t) {
+    if (!NAME(finite)((size_t)(p + 1) * dim, s->c)) return NAME(fail_non_finite)(o, s, t, y);
     char detail[160];
     snprintf(detail, sizeof detail,
              "the series allows only h = %.3g, below the resolution of t; the solution may be "
@@ -143,9 +160,7 @@ static int NAME(step)(sicm_ode *o, NAME(state) * s, REAL limit, double *t, doubl
   if (!NAME(finite)(dim, s->y)) {
     for (size_t i = 0; i < dim; i++) /* back to the last accepted point */
       s->y[i] = s->c[i];
-    NAME(report)(o, s, t, y);
-    return sicm_ode_fail(o, SICM_EBADFUNC, *t, y, "non-finite state",
-                         "a Taylor step gave NaN or infinite components");
+    return NAME(fail_non_finite)(o, s, t, y);
   }
   s->t0 = s->t;
   s->t = final ? limit : s->t + h;
