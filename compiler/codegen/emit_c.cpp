@@ -32,6 +32,7 @@
 #include "algebra/linear_solve.hpp"
 #include "base/error.hpp"
 #include "codegen/jit.hpp"
+#include "codegen/loops.hpp"
 #include "codegen/schedule.hpp"
 #include "sicm/runtime.h"
 
@@ -51,11 +52,30 @@ public:
           const std::function<std::string(ExprId)> &site_of = nullptr)
       : s_(s), spell_(spell), prefix_(prefix), site_(site), site_of_(site_of) {}
 
-  // The steps, each line starting with indent, outputs into targets.
-  std::string statements(const std::vector<std::string> &targets, const std::string &indent) {
+  // The steps, each line starting with indent, outputs into targets; runs of repeated
+  // steps as loops when index_of names the symbols as array elements (codegen/loops.hpp).
+  std::string statements(const std::vector<std::string> &targets, const std::string &indent,
+                         const SymbolIndex *index_of = nullptr) {
     std::string out;
     auto line = [&](const std::string &text) { out += indent + text + "\n"; };
-    for (const Step &step : s_.steps) {
+    if (index_of && site_.empty()) plan_ = plan_loops(s_, *index_of, targets);
+    std::unordered_map<size_t, size_t> block_at, gather_at;
+    for (size_t b = 0; b < plan_.blocks.size(); ++b)
+      block_at[plan_.blocks[b].first] = b;
+    for (size_t g = 0; g < plan_.gathers.size(); ++g)
+      gather_at[plan_.gathers[g].first] = g;
+    for (size_t i = 0; i < s_.steps.size(); ++i) {
+      if (auto b = block_at.find(i); b != block_at.end()) {
+        out += block(b->second, indent);
+        i += plan_.blocks[b->second].period * plan_.blocks[b->second].count - 1;
+        continue;
+      }
+      if (auto g = gather_at.find(i); g != gather_at.end()) {
+        out += gather(g->second, targets, indent);
+        i += plan_.gathers[g->second].count - 1;
+        continue;
+      }
+      const Step &step = s_.steps[i];
       std::string t = temp(step.temp), n = std::to_string(step.n);
       switch (step.kind) {
       case StepKind::Define: line("  double " + t + " = " + text(step.term) + ";"); break;
@@ -115,6 +135,94 @@ public:
 
 private:
   std::string temp(uint32_t n) const { return prefix_ + std::to_string(n); }
+  std::string name(const char *what, size_t n) const { return prefix_ + what + std::to_string(n); }
+
+  // A static table of ints, sixteen to a line.
+  static std::string table(const std::string &name, const std::vector<long> &v,
+                           const std::string &indent) {
+    std::string s =
+        indent + "  static const int " + name + "[" + std::to_string(v.size()) + "] = {";
+    for (size_t k = 0; k < v.size(); ++k)
+      s += (k % 16 ? " " : "\n" + indent + "    ") + std::to_string(v[k]) + ",";
+    return s + "\n" + indent + "  };\n";
+  }
+
+  // Instance k's index of slot j of block b, as C.
+  std::string column(size_t b, size_t j, const std::string &k) const {
+    const LoopColumn &c = plan_.blocks[b].slots[j].column;
+    switch (c.kind) {
+    case LoopColumn::Affine: {
+      if (c.stride == 0) return std::to_string(c.base);
+      std::string s = c.stride == 1 ? k : std::to_string(c.stride) + " * " + k;
+      return c.base == 0 ? s : std::to_string(c.base) + " + " + s;
+    }
+    case LoopColumn::Offset:
+      return column(b, size_t(c.of), k) + (c.base < 0 ? " - " : " + ") +
+             std::to_string(c.base < 0 ? -c.base : c.base);
+    case LoopColumn::Table: return name("x", b) + "_" + std::to_string(j) + "[" + k + "]";
+    }
+    return "";
+  }
+
+  // Block b as a loop over its instances, its escaping values into its array.
+  std::string block(size_t b, const std::string &indent) {
+    const LoopBlock &blk = plan_.blocks[b];
+    std::string out, k = name("k", b);
+    for (size_t j = 0; j < blk.slots.size(); ++j)
+      if (blk.slots[j].scalar < 0 && blk.slots[j].column.kind == LoopColumn::Table)
+        out += table(name("x", b) + "_" + std::to_string(j), blk.slots[j].column.table, indent);
+    if (blk.nescape)
+      out += indent + "  double " + name("v", b) + "[" + std::to_string(blk.nescape * blk.count) +
+             "];\n";
+    out += indent + "  for (int " + k + " = 0; " + k + " < " + std::to_string(blk.count) + "; ++" +
+           k + ") {\n";
+    override_.clear();
+    for (auto [term, slot] : blk.leaf_slot) {
+      const LoopSlot &sl = blk.slots[size_t(slot)];
+      override_[term] = sl.scalar >= 0 ? temp(uint32_t(sl.scalar))
+                        : sl.block >= 0
+                            ? name("v", size_t(sl.block)) + "[" + column(b, size_t(slot), k) + "]"
+                            : sl.array + "[" + column(b, size_t(slot), k) + "]";
+    }
+    auto local = [&](uint32_t q) { return name("l", b) + "_" + std::to_string(q); };
+    for (auto [term, q] : blk.local)
+      override_[term] = local(q);
+    for (size_t q = 0; q < blk.period; ++q) {
+      out += indent + "    double " + local(uint32_t(q)) + " = " +
+             text(s_.steps[blk.first + q].term) + ";\n";
+      if (blk.escape[q] >= 0)
+        out += indent + "    " + name("v", b) + "[" + std::to_string(blk.nescape) + " * " + k +
+               " + " + std::to_string(blk.escape[q]) + "] = " + local(uint32_t(q)) + ";\n";
+    }
+    override_.clear();
+    return out + indent + "  }\n";
+  }
+
+  // Gather g as a loop over its outputs, each summed in the unrolled sum's order.
+  std::string gather(size_t g, const std::vector<std::string> &targets, const std::string &indent) {
+    const LoopGather &ga = plan_.gathers[g];
+    std::string t = name("g", g), st = t + "_start", v = name("v", size_t(ga.block));
+    std::string o = name("o", g), k = name("j", g), acc = name("a", g);
+    std::string out = table(t, ga.table, indent) + table(st, ga.start, indent);
+    const std::string &first = targets[s_.steps[ga.first].output];
+    std::string array = first.substr(0, first.find('['));
+    std::string index0 = first.substr(first.find('[') + 1, first.size() - first.find('[') - 2);
+    auto term = [&](const std::string &e) {
+      return v + "[" + e + " >= 0 ? " + e + " : ~" + e + "]";
+    };
+    out += indent + "  for (int " + o + " = 0; " + o + " < " + std::to_string(ga.count) + "; ++" +
+           o + ") {\n";
+    out += indent + "    int " + k + " = " + st + "[" + o + "];\n";
+    std::string e0 = t + "[" + k + "]";
+    out += indent + "    double " + acc + " = " + e0 + " >= 0 ? " + term(e0) + " : -" + term(e0) +
+           ";\n";
+    out += indent + "    for (++" + k + "; " + k + " < " + st + "[" + o + " + 1]; ++" + k + ")\n";
+    out += indent + "      " + acc + " = " + e0 + " >= 0 ? " + acc + " + " + term(e0) + " : " +
+           acc + " - " + term(e0) + ";\n";
+    out += indent + "    " + array + "[" + index0 + " + " + o + "] = " + (ga.negate ? "-" : "") +
+           acc + ";\n";
+    return out + indent + "  }\n";
+  }
 
   std::string list(const std::vector<uint32_t> &terms) {
     std::string s;
@@ -162,11 +270,16 @@ private:
   }
 
   std::string text(uint32_t t) {
+    if (!override_.empty())
+      if (auto it = override_.find(t); it != override_.end()) return it->second;
     const Term &term = s_.terms[t];
     switch (term.kind) {
     case TermKind::Literal: return term.text;
     case TermKind::Symbol: return spell_(term.symbol);
-    case TermKind::Temp: return temp(term.temp);
+    case TermKind::Temp:
+      if (auto it = plan_.home.find(term.temp); it != plan_.home.end())
+        return name("v", size_t(it->second.first)) + "[" + std::to_string(it->second.second) + "]";
+      return temp(term.temp);
     case TermKind::Element: return temp(term.temp) + "[" + std::to_string(term.element) + "]";
     case TermKind::Paren: return "(" + text(term.args[0]) + ")";
     case TermKind::Neg: return "-" + wrap(term.args[0], kAtom);
@@ -199,6 +312,8 @@ private:
   const std::function<std::string(Symbol *)> &spell_;
   const std::string &prefix_, &site_;
   const std::function<std::string(ExprId)> &site_of_;
+  LoopPlan plan_;
+  std::unordered_map<uint32_t, std::string> override_; // a loop body's leaves
 };
 
 } // namespace
@@ -289,7 +404,21 @@ std::string emit_kernel_function(const Trace &t, const std::string &c_name, bool
   std::vector<std::string> targets;
   for (size_t j = 0; j < t.outputs.size(); ++j)
     targets.push_back("out[" + std::to_string(j) + "]");
-  std::string body = Printer(schedule_outputs(t.outputs), spell, "t", "").statements(targets, "");
+  SymbolIndex index_of = [&](Symbol *s, std::string *array, long *index) {
+    auto k = param.find(s);
+    if (k != param.end()) {
+      *array = "p";
+      *index = long(k->second);
+      return true;
+    }
+    auto in = input.find(s);
+    if (in == input.end()) return false;
+    *array = "in";
+    *index = long(in->second);
+    return true;
+  };
+  std::string body =
+      Printer(schedule_outputs(t.outputs), spell, "t", "").statements(targets, "", &index_of);
   std::string f = is_static ? "static " : "";
   f += "void " + c_name + "(const double *in, double *out, const double *p) {\n";
   if (!uses_in) f += "  (void)in;\n";
@@ -305,9 +434,11 @@ std::string emit_c_assignments(const std::vector<ExprId> &values,
                                const std::function<std::string(Symbol *)> &spell,
                                const std::string &temp_prefix, const std::string &indent,
                                const std::string &checked_site,
-                               const std::function<std::string(ExprId)> &site_of) {
+                               const std::function<std::string(ExprId)> &site_of,
+                               const SymbolIndex *index_of) {
   Schedule s = schedule_outputs(values, !checked_site.empty());
-  return Printer(s, spell, temp_prefix, checked_site, site_of).statements(targets, indent);
+  return Printer(s, spell, temp_prefix, checked_site, site_of)
+      .statements(targets, indent, index_of);
 }
 
 bool uses_linear_solve(const std::vector<ExprId> &outputs) {

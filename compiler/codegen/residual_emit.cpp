@@ -940,10 +940,40 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       std::vector<std::string> targets;
       for (size_t j = 0; j < fn.outputs.size(); ++j)
         targets.push_back("out[" + std::to_string(j) + "]");
-      code += fn.kernel && fn.body.empty()
-                  ? emit_c_assignments(
-                        fn.outputs, targets, [this](Symbol *s) { return spell(s); }, "o", "")
-                  : checked_assignments(fn.outputs, targets, "o", fn.loc);
+      if (fn.kernel && fn.body.empty()) {
+        // A loop (codegen/loops.hpp) reads its inputs and captures from in[] and p[].
+        SymbolIndex index_of = [&](Symbol *s, std::string *array, long *index) {
+          int v = var_id(s);
+          for (size_t i = 0; i < fn.inputs.size(); ++i)
+            if (fn.inputs[i] == v) {
+              *array = "in";
+              *index = long(i);
+              return true;
+            }
+          long k = 0;
+          for (int c : captures_[f]) {
+            if (c == v) {
+              *array = "p";
+              *index = k;
+              return true;
+            }
+            ++k;
+          }
+          return false;
+        };
+        std::string assignments = emit_c_assignments(
+            fn.outputs, targets, [this](Symbol *s) { return spell(s); }, "o", "", "", nullptr,
+            &index_of);
+        if (assignments.find("  for (") != std::string::npos)
+          for (size_t i = 0; i < fn.inputs.size(); ++i)
+            if (used_[f].count(fn.inputs[i])) code += "  (void)" + var_name(fn.inputs[i]) + ";\n";
+        if (assignments.find("  for (") != std::string::npos)
+          for (int v : captures_[f])
+            code += "  (void)" + var_name(v) + ";\n";
+        code += assignments;
+      } else {
+        code += checked_assignments(fn.outputs, targets, "o", fn.loc);
+      }
     }
     return code + "}\n\n";
   }
