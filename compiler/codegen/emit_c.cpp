@@ -59,20 +59,21 @@ public:
     std::string out;
     auto line = [&](const std::string &text) { out += indent + text + "\n"; };
     if (index_of && site_.empty()) plan_ = plan_loops(s_, *index_of, targets);
-    std::unordered_map<size_t, size_t> block_at, gather_at;
+    std::unordered_map<size_t, size_t> block_at, scatter_at;
     for (size_t b = 0; b < plan_.blocks.size(); ++b)
-      block_at[plan_.blocks[b].first] = b;
-    for (size_t g = 0; g < plan_.gathers.size(); ++g)
-      gather_at[plan_.gathers[g].first] = g;
+      block_at[plan_.blocks[b].segments[0].first] = b;
+    for (size_t g = 0; g < plan_.scatters.size(); ++g)
+      scatter_at[plan_.scatters[g].first] = g;
     for (size_t i = 0; i < s_.steps.size(); ++i) {
       if (auto b = block_at.find(i); b != block_at.end()) {
         out += block(b->second, indent);
-        i += plan_.blocks[b->second].period * plan_.blocks[b->second].count - 1;
+        i = plan_.blocks[b->second].end() - 1;
         continue;
       }
-      if (auto g = gather_at.find(i); g != gather_at.end()) {
-        out += gather(g->second, targets, indent);
-        i += plan_.gathers[g->second].count - 1;
+      if (auto g = scatter_at.find(i); g != scatter_at.end()) {
+        const LoopScatter &sc = plan_.scatters[g->second];
+        if (sc.negate) out += outputs_loop(sc, indent, "-");
+        i += sc.count - 1;
         continue;
       }
       const Step &step = s_.steps[i];
@@ -147,30 +148,54 @@ private:
     return s + "\n" + indent + "  };\n";
   }
 
+  static std::string affine(long base, long stride, const std::string &k) {
+    if (stride == 0) return std::to_string(base);
+    std::string s = stride == 1 ? k : std::to_string(stride) + " * " + k;
+    return base == 0 ? s : std::to_string(base) + " + " + s;
+  }
+  static std::string plus(long d) {
+    if (d == 0) return "";
+    return (d < 0 ? " - " : " + ") + std::to_string(d < 0 ? -d : d);
+  }
+
   // Instance k's index of slot j of block b, as C.
   std::string column(size_t b, size_t j, const std::string &k) const {
     const LoopColumn &c = plan_.blocks[b].slots[j].column;
     switch (c.kind) {
-    case LoopColumn::Affine: {
-      if (c.stride == 0) return std::to_string(c.base);
-      std::string s = c.stride == 1 ? k : std::to_string(c.stride) + " * " + k;
-      return c.base == 0 ? s : std::to_string(c.base) + " + " + s;
-    }
-    case LoopColumn::Offset:
-      return column(b, size_t(c.of), k) + (c.base < 0 ? " - " : " + ") +
-             std::to_string(c.base < 0 ? -c.base : c.base);
+    case LoopColumn::Affine: return affine(c.base, c.stride, k);
+    case LoopColumn::Offset: return column(b, size_t(c.of), k) + plus(c.base);
     case LoopColumn::Table: return name("x", b) + "_" + std::to_string(j) + "[" + k + "]";
     }
     return "";
   }
 
-  // Block b as a loop over its instances, its escaping values into its array.
+  // Each output of sc set to `prefix` itself (-0.0, or minus itself), as a loop.
+  std::string outputs_loop(const LoopScatter &sc, const std::string &indent,
+                           const std::string &prefix) {
+    std::string o = name("o", &sc - plan_.scatters.data());
+    std::string t = sc.array + "[" + std::to_string(sc.index0) + " + " + o + "]";
+    return indent + "  for (int " + o + " = 0; " + o + " < " + std::to_string(sc.count) + "; ++" +
+           o + ")\n" + indent + "    " + t + " = " + (prefix == "-" ? "-" + t : prefix) + ";\n";
+  }
+
+  // Block b as a loop over its instances, its escaping values into its array and the
+  // outputs it accumulates.
   std::string block(size_t b, const std::string &indent) {
     const LoopBlock &blk = plan_.blocks[b];
     std::string out, k = name("k", b);
     for (size_t j = 0; j < blk.slots.size(); ++j)
       if (blk.slots[j].scalar < 0 && blk.slots[j].column.kind == LoopColumn::Table)
         out += table(name("x", b) + "_" + std::to_string(j), blk.slots[j].column.table, indent);
+    std::vector<const LoopScatter *> scatters;
+    for (const LoopScatter &sc : plan_.scatters)
+      if (sc.block == int(b)) {
+        scatters.push_back(&sc);
+        for (size_t r = 0; r < sc.terms.size(); ++r)
+          if (sc.terms[r].column.kind == LoopColumn::Table)
+            out += table(name("y", size_t(&sc - plan_.scatters.data())) + "_" + std::to_string(r),
+                         sc.terms[r].column.table, indent);
+        out += outputs_loop(sc, indent, "-0.0");
+      }
     if (blk.nescape)
       out += indent + "  double " + name("v", b) + "[" + std::to_string(blk.nescape * blk.count) +
              "];\n";
@@ -184,43 +209,40 @@ private:
                             ? name("v", size_t(sl.block)) + "[" + column(b, size_t(slot), k) + "]"
                             : sl.array + "[" + column(b, size_t(slot), k) + "]";
     }
-    auto local = [&](uint32_t q) { return name("l", b) + "_" + std::to_string(q); };
+    auto local = [&](size_t q) { return name("l", b) + "_" + std::to_string(q); };
     for (auto [term, q] : blk.local)
       override_[term] = local(q);
-    for (size_t q = 0; q < blk.period; ++q) {
-      out += indent + "    double " + local(uint32_t(q)) + " = " +
-             text(s_.steps[blk.first + q].term) + ";\n";
-      if (blk.escape[q] >= 0)
-        out += indent + "    " + name("v", b) + "[" + std::to_string(blk.nescape) + " * " + k +
-               " + " + std::to_string(blk.escape[q]) + "] = " + local(uint32_t(q)) + ";\n";
-    }
+    size_t q = 0;
+    for (auto [first, period] : blk.segments)
+      for (size_t r = 0; r < period; ++r, ++q) {
+        out += indent + "    double " + local(q) + " = " + text(s_.steps[first + r].term) + ";\n";
+        if (blk.escape[q] >= 0)
+          out += indent + "    " + name("v", b) + "[" + std::to_string(blk.nescape) + " * " + k +
+                 " + " + std::to_string(blk.escape[q]) + "] = " + local(q) + ";\n";
+      }
     override_.clear();
-    return out + indent + "  }\n";
-  }
-
-  // Gather g as a loop over its outputs, each summed in the unrolled sum's order.
-  std::string gather(size_t g, const std::vector<std::string> &targets, const std::string &indent) {
-    const LoopGather &ga = plan_.gathers[g];
-    std::string t = name("g", g), st = t + "_start", v = name("v", size_t(ga.block));
-    std::string o = name("o", g), k = name("j", g), acc = name("a", g);
-    std::string out = table(t, ga.table, indent) + table(st, ga.start, indent);
-    const std::string &first = targets[s_.steps[ga.first].output];
-    std::string array = first.substr(0, first.find('['));
-    std::string index0 = first.substr(first.find('[') + 1, first.size() - first.find('[') - 2);
-    auto term = [&](const std::string &e) {
-      return v + "[" + e + " >= 0 ? " + e + " : ~" + e + "]";
-    };
-    out += indent + "  for (int " + o + " = 0; " + o + " < " + std::to_string(ga.count) + "; ++" +
-           o + ") {\n";
-    out += indent + "    int " + k + " = " + st + "[" + o + "];\n";
-    std::string e0 = t + "[" + k + "]";
-    out += indent + "    double " + acc + " = " + e0 + " >= 0 ? " + term(e0) + " : -" + term(e0) +
-           ";\n";
-    out += indent + "    for (++" + k + "; " + k + " < " + st + "[" + o + " + 1]; ++" + k + ")\n";
-    out += indent + "      " + acc + " = " + e0 + " >= 0 ? " + acc + " + " + term(e0) + " : " +
-           acc + " - " + term(e0) + ";\n";
-    out += indent + "    " + array + "[" + index0 + " + " + o + "] = " + (ga.negate ? "-" : "") +
-           acc + ";\n";
+    // Each output's terms in position order, as its unrolled sum has them.
+    for (size_t pos = 0; pos < q; ++pos)
+      for (const LoopScatter *sc : scatters) {
+        size_t g = size_t(sc - plan_.scatters.data());
+        for (size_t r = 0; r < sc->terms.size(); ++r) {
+          const LoopScatter::Term &term = sc->terms[r];
+          if (term.position != pos) continue;
+          std::string idx;
+          switch (term.column.kind) {
+          case LoopColumn::Affine: idx = affine(term.column.base, term.column.stride, k); break;
+          case LoopColumn::Offset:
+            idx = column(b, size_t(term.column.of), k) + plus(term.column.base);
+            break;
+          case LoopColumn::Table:
+            idx = name("y", g) + "_" + std::to_string(r) + "[" + k + "]";
+            break;
+          }
+          std::string t = sc->array + "[" + std::to_string(sc->index0) + " + " + idx + "]";
+          out +=
+              indent + "    " + t + " = " + t + (term.minus ? " - " : " + ") + local(pos) + ";\n";
+        }
+      }
     return out + indent + "  }\n";
   }
 

@@ -1,26 +1,32 @@
 // Repeated structure in a schedule found as loops (see loops.hpp).
 //
 // Approach, after heyoka's compact mode: the scheduler writes an N-body derivative as the
-// same few steps once per pair (three differences and a distance, then the inverse cube and
-// three force components) and each output as a sum of N - 1 of those components. A block is
-// a run of `count` consecutive instances of `period` Define steps whose term trees have one
-// shape once their leaves are abstracted: a symbol or a temporary computed outside the
-// instance becomes a slot (numbered by first appearance, so that which leaves coincide is
-// part of the shape), a temporary computed inside it its position. Each slot's indices over
-// the instances are a column: affine in the instance number, a constant offset from an
-// earlier column (y_i beside x_i), or a static table. Values an instance computes that
+// same few steps once per pair (three differences and a distance; later the inverse cube
+// and three force components) and each output as a sum of N - 1 of those components. A
+// block is a run of `count` consecutive instances of a few Define steps whose term trees
+// have one shape once their leaves are abstracted: a symbol or a temporary computed outside
+// the instance becomes a slot (numbered by first appearance, so that which leaves coincide
+// is part of the shape), a temporary computed inside it its position. A run that follows a
+// block with as many instances, each reading only its own instance's values of the block,
+// joins it as a second segment of the same loop body (the distances and the forces of a
+// pair in one iteration). Each slot's indices over the instances are a column: affine in
+// the instance number, a constant offset from an earlier column (y_i beside x_i, or the
+// output of body i beside its input), or a static table. Values an instance computes that
 // later steps read are kept in one array per block; the rest stay locals of the loop body.
-// A gather is a run of outputs, each a left-folded chain of + and - over one block's
-// values, written as a loop over a table of signed element indices.
+// Outputs that are each a chain of + and - over one block's values, with every output's
+// terms in the loop's order, are accumulated by the loop (LoopScatter), as a hand-written
+// N-body loop does, and their values then need no array.
 //
 // Limits, named below: a block needs kMinLoopInstances instances and kMinLoopSteps steps, so
 // that small kernels (a pendulum, a handful of bodies) keep their straight-line C, which
-// the C compiler schedules best; periods up to kMaxPeriod steps are tried; the values
-// arrays live on the stack, kMaxValuesBytes in all. What does not fit stays unrolled.
+// the C compiler schedules best; runs of up to kMaxPeriod steps per instance are tried; the
+// values arrays live on the stack, kMaxValuesBytes in all. What does not fit stays unrolled.
 #include "codegen/loops.hpp"
 
+#include <algorithm>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace sicm {
 
@@ -43,10 +49,19 @@ struct Instance {
   std::vector<Leaf> leaves;
 };
 
+using Segments = std::vector<std::pair<size_t, size_t>>;
+
+// Where a block computes a temporary: block, instance, position.
+struct Origin {
+  int block;
+  size_t instance;
+  uint32_t position;
+};
+
 class Planner {
 public:
   Planner(const Schedule &s, const SymbolIndex &index_of, const std::vector<std::string> &targets)
-      : s_(s), index_of_(index_of), targets_(targets), def_(s.ntemps, -1), last_use_(s.ntemps, 0) {
+      : s_(s), index_of_(index_of), targets_(targets), def_(s.ntemps, -1) {
     for (size_t i = 0; i < s.steps.size(); ++i) {
       const Step &step = s.steps[i];
       if (step.kind == StepKind::Define || step.kind == StepKind::SinCos ||
@@ -54,25 +69,46 @@ public:
           step.kind == StepKind::SolveInterpreted)
         def_[step.temp] = long(i);
       if (step.kind == StepKind::SinCos) def_[step.temp2] = long(i);
+    }
+  }
+
+  // Blocks first; then the outputs they can accumulate; then the blocks again, now knowing
+  // which values only those outputs read (they need no array).
+  LoopPlan plan() {
+    find_uses({});
+    find_blocks();
+    if (plan_.blocks.empty()) return {};
+    std::unordered_set<size_t> scattered = find_scatters();
+    if (scattered.empty()) return std::move(plan_);
+    LoopPlan first = plan_; // valid as it is, keeping every value the outputs read
+    find_uses(scattered);
+    plan_ = {};
+    origin_.clear();
+    columns_.clear();
+    values_bytes_ = 0;
+    find_blocks();
+    if (find_scatters() != scattered) return first;
+    return std::move(plan_);
+  }
+
+private:
+  // last_use_[temp]: the last step, not one of `skip`, that reads temp.
+  void find_uses(const std::unordered_set<size_t> &skip) {
+    last_use_.assign(s_.ntemps, 0);
+    for (size_t i = 0; i < s_.steps.size(); ++i) {
+      if (skip.count(i)) continue;
+      const Step &step = s_.steps[i];
       if (step.kind == StepKind::Define || step.kind == StepKind::SinCos ||
           step.kind == StepKind::Output)
         note_uses(step.term, i);
       for (uint32_t t : step.terms)
         note_uses(t, i);
       if (step.kind == StepKind::Solve) last_use_[step.temp2] = i;
+      for (uint32_t f : step.flags)
+        last_use_[f] = i;
     }
   }
 
-  LoopPlan plan() {
-    for (size_t i = 0; i < s_.steps.size();) {
-      size_t n = try_block(i);
-      i += n ? n : 1;
-    }
-    if (!plan_.blocks.empty()) find_gathers();
-    return std::move(plan_);
-  }
-
-private:
   void note_uses(uint32_t t, size_t step) {
     const Term &term = s_.terms[t];
     if (term.kind == TermKind::Temp || term.kind == TermKind::Element)
@@ -81,22 +117,41 @@ private:
       note_uses(a, step);
   }
 
-  // The shape and leaves of steps [first, first + period), false if a step is not a Define
-  // or a term cannot be in a loop. Records instance 0's leaf terms in `block` when given.
-  bool instance(size_t first, size_t period, Instance *out, LoopBlock *block) {
+  void find_blocks() {
+    for (size_t i = 0; i < s_.steps.size();) {
+      size_t end = try_block(i);
+      i = end > i ? end : i + 1;
+    }
+  }
+
+  // The position of the step computing temporary `def` in instance m of segs, or -1.
+  static long position_of(long def, const Segments &segs, size_t m) {
+    long base = 0;
+    for (auto [first, period] : segs) {
+      long lo = long(first + m * period);
+      if (def >= lo && def < lo + long(period)) return base + def - lo;
+      base += long(period);
+    }
+    return -1;
+  }
+
+  // The shape and leaves of instance m of segs, false if a step is not a Define or a term
+  // cannot be in a loop. Records instance 0's leaf terms in `block` when given.
+  bool instance(const Segments &segs, size_t m, Instance *out, LoopBlock *block) {
     std::unordered_map<Symbol *, int> symbols;
     std::unordered_map<uint32_t, int> temps;
-    for (size_t q = 0; q < period; ++q) {
-      const Step &step = s_.steps[first + q];
-      if (step.kind != StepKind::Define) return false;
-      out->shape += "D";
-      if (!walk(step.term, first, symbols, temps, out, block)) return false;
-      out->shape += ';';
-    }
+    for (auto [first, period] : segs)
+      for (size_t q = 0; q < period; ++q) {
+        const Step &step = s_.steps[first + m * period + q];
+        if (step.kind != StepKind::Define) return false;
+        out->shape += "D";
+        if (!walk(step.term, segs, m, symbols, temps, out, block)) return false;
+        out->shape += ';';
+      }
     return true;
   }
 
-  bool walk(uint32_t t, size_t first, std::unordered_map<Symbol *, int> &symbols,
+  bool walk(uint32_t t, const Segments &segs, size_t m, std::unordered_map<Symbol *, int> &symbols,
             std::unordered_map<uint32_t, int> &temps, Instance *out, LoopBlock *block) {
     const Term &term = s_.terms[t];
     std::string &shape = out->shape;
@@ -119,10 +174,10 @@ private:
       return true;
     }
     case TermKind::Temp: {
-      long def = def_[term.temp];
-      if (def >= long(first)) { // computed in this instance, by the step at its position
-        shape += "T" + std::to_string(def - long(first)) + ",";
-        if (block) block->local[t] = uint32_t(def - long(first));
+      long q = position_of(def_[term.temp], segs, m);
+      if (q >= 0) { // computed in this instance
+        shape += "T" + std::to_string(q) + ",";
+        if (block) block->local[t] = uint32_t(q);
         return true;
       }
       auto it = temps.find(term.temp);
@@ -150,7 +205,7 @@ private:
     case TermKind::Call:
       shape += std::to_string(int(term.kind)) + term.text + "(";
       for (uint32_t a : term.args)
-        if (!walk(a, first, symbols, temps, out, block)) return false;
+        if (!walk(a, segs, m, symbols, temps, out, block)) return false;
       shape += ")";
       return true;
     }
@@ -163,51 +218,71 @@ private:
     return it == plan_.home.end() ? std::pair<int, long>(-1, temp) : it->second;
   }
 
-  // Do instance m's leaves sit where instance 0's do (the same array, block or scalar)?
-  bool compatible(const Instance &a, const Instance &b) const {
+  // Does instance b read its leaves where instance a does (the same array, values array or
+  // scalar), every temporary it reads computed before the block starts at `start`?
+  bool compatible(const Instance &a, const Instance &b, size_t start) const {
     for (size_t j = 0; j < a.leaves.size(); ++j) {
       const Leaf &x = a.leaves[j], &y = b.leaves[j];
       if (x.array != y.array) return false;
       if (!x.array.empty()) continue;
+      if (def_[y.index] >= long(start)) return false;
       auto wx = where(x.index), wy = where(y.index);
       if (wx.first != wy.first || (wx.first < 0 && wx.second != wy.second)) return false;
     }
     return true;
   }
 
-  // The longest block starting at step i, entered in the plan; its number of steps, or 0.
+  // The instances of segs, as many as have instance 0's shape (at most `limit`).
+  std::vector<Instance> run(const Segments &segs, size_t limit) {
+    std::vector<Instance> insts;
+    for (size_t m = 0; m < limit; ++m) {
+      bool fits = true;
+      for (auto [first, period] : segs)
+        fits = fits && first + (m + 1) * period <= s_.steps.size();
+      Instance inst;
+      if (!fits || !instance(segs, m, &inst, nullptr)) break;
+      if (m > 0 && inst.shape != insts[0].shape) break;
+      if (!compatible(m ? insts[0] : inst, inst, segs[0].first)) break;
+      insts.push_back(std::move(inst));
+    }
+    return insts;
+  }
+
+  // The longest block starting at step i, with the segments that follow it, entered in the
+  // plan; the step after it, or i if there is none.
   size_t try_block(size_t i) {
-    size_t best_period = 0, best_count = 0;
-    std::vector<Instance> best;
+    Segments best;
+    std::vector<Instance> insts;
     for (size_t period = 1; period <= kMaxPeriod; ++period) {
-      std::vector<Instance> run;
-      for (size_t m = 0; i + (m + 1) * period <= s_.steps.size(); ++m) {
-        Instance inst;
-        if (!instance(i + m * period, period, &inst, nullptr)) break;
-        if (m > 0 && (inst.shape != run[0].shape || !compatible(run[0], inst))) break;
-        if (m == 0 && !first_leaves_outside(inst, i)) break;
-        run.push_back(std::move(inst));
-      }
-      if (run.size() * period > best_count * best_period) {
-        best_period = period;
-        best_count = run.size();
-        best = std::move(run);
+      std::vector<Instance> r = run({{i, period}}, s_.steps.size());
+      if (r.size() * period > insts.size() * (best.empty() ? 0 : best[0].second)) {
+        best = {{i, period}};
+        insts = std::move(r);
       }
     }
-    if (best_count < kMinLoopInstances || best_count * best_period < kMinLoopSteps) return 0;
-    return enter_block(i, best_period, best);
+    size_t count = insts.size();
+    if (best.empty() || count < kMinLoopInstances || count * best[0].second < kMinLoopSteps) return i;
+    for (bool grew = true; grew;) {
+      grew = false;
+      size_t next = best.back().first + best.back().second * count;
+      for (size_t period = 1; period <= kMaxPeriod && !grew; ++period) {
+        Segments segs = best;
+        segs.push_back({next, period});
+        std::vector<Instance> r = run(segs, count);
+        if (r.size() == count) {
+          best = std::move(segs);
+          insts = std::move(r);
+          grew = true;
+        }
+      }
+    }
+    return enter_block(best, insts) ? best.back().first + best.back().second * count : i;
   }
 
-  // Instance 0's outside temporaries are computed before the block (not by an instance of
-  // it, which a loop could not read before writing).
-  bool first_leaves_outside(const Instance &inst, size_t first) const {
-    for (const Leaf &leaf : inst.leaves)
-      if (leaf.array.empty() && def_[leaf.index] >= long(first)) return false;
-    return true;
-  }
-
+  // The column of v (an index per instance), as an offset from one of `cols` (the block's
+  // slots' columns so far) when it is one.
   static LoopColumn column(const std::vector<long> &v, const std::vector<std::vector<long>> &cols,
-                           const std::vector<LoopSlot> &slots, const LoopSlot &self) {
+                           const std::vector<LoopSlot> &slots) {
     LoopColumn c;
     long stride = v.size() > 1 ? v[1] - v[0] : 0;
     bool affine = true;
@@ -219,9 +294,7 @@ private:
       return c;
     }
     for (size_t j = 0; j < cols.size(); ++j) {
-      if (slots[j].array != self.array || slots[j].block != self.block || slots[j].scalar >= 0)
-        continue;
-      if (slots[j].column.kind == LoopColumn::Offset) continue;
+      if (slots[j].scalar >= 0 || slots[j].column.kind != LoopColumn::Table) continue;
       long d = v[0] - cols[j][0];
       bool same = true;
       for (size_t k = 0; k < v.size() && same; ++k)
@@ -238,57 +311,66 @@ private:
     return c;
   }
 
-  size_t enter_block(size_t first, size_t period, const std::vector<Instance> &run) {
+  bool enter_block(const Segments &segs, const std::vector<Instance> &insts) {
     LoopBlock b;
-    b.first = first;
-    b.period = period;
-    b.count = run.size();
+    b.segments = segs;
+    b.count = insts.size();
     Instance again;
-    instance(first, period, &again, &b);
-    // Which positions are read after their instance.
-    b.escape.assign(period, -1);
-    for (size_t m = 0; m < b.count; ++m) {
-      size_t end = first + (m + 1) * period;
-      for (size_t q = 0; q < period; ++q)
-        if (b.escape[q] < 0 && last_use_[s_.steps[first + m * period + q].temp] >= end)
+    instance(segs, 0, &again, &b);
+    // Which positions later steps read, after the block.
+    size_t end = b.end(), npos = b.positions();
+    b.escape.assign(npos, -1);
+    for (size_t m = 0; m < b.count; ++m)
+      for (size_t q = 0; q < npos; ++q)
+        if (b.escape[q] < 0 && last_use_[s_.steps[step_of(segs, m, q)].temp] >= end)
           b.escape[q] = int(b.nescape++);
-    }
-    if (b.nescape * b.count * sizeof(double) + values_bytes_ > kMaxValuesBytes) return 0;
+    if (b.nescape * b.count * sizeof(double) + values_bytes_ > kMaxValuesBytes) return false;
     values_bytes_ += b.nescape * b.count * sizeof(double);
     std::vector<std::vector<long>> cols;
-    for (size_t j = 0; j < run[0].leaves.size(); ++j) {
+    for (size_t j = 0; j < insts[0].leaves.size(); ++j) {
       LoopSlot slot;
       std::vector<long> v;
-      const Leaf &l0 = run[0].leaves[j];
+      const Leaf &l0 = insts[0].leaves[j];
       slot.array = l0.array;
       if (l0.array.empty()) {
         auto w = where(l0.index);
         slot.block = w.first;
         if (w.first < 0) slot.scalar = w.second;
       }
-      for (const Instance &inst : run) {
+      for (const Instance &inst : insts) {
         const Leaf &l = inst.leaves[j];
         v.push_back(l.array.empty() ? where(l.index).second : l.index);
       }
-      if (slot.scalar < 0) slot.column = column(v, cols, b.slots, slot);
+      if (slot.scalar < 0) slot.column = column(v, cols, b.slots);
       cols.push_back(std::move(v));
       b.slots.push_back(std::move(slot));
     }
     int id = int(plan_.blocks.size());
     for (size_t m = 0; m < b.count; ++m)
-      for (size_t q = 0; q < period; ++q)
-        if (b.escape[q] >= 0)
-          plan_.home[s_.steps[first + m * period + q].temp] = {id,
-                                                               long(m * b.nescape) + b.escape[q]};
+      for (size_t q = 0; q < npos; ++q) {
+        uint32_t temp = s_.steps[step_of(segs, m, q)].temp;
+        origin_[temp] = {id, m, uint32_t(q)};
+        if (b.escape[q] >= 0) plan_.home[temp] = {id, long(m * b.nescape) + b.escape[q]};
+      }
+    columns_.push_back(std::move(cols));
     plan_.blocks.push_back(std::move(b));
-    return period * run.size();
+    return true;
+  }
+
+  static size_t step_of(const Segments &segs, size_t m, size_t q) {
+    for (auto [first, period] : segs) {
+      if (q < period) return first + m * period + q;
+      q -= period;
+    }
+    return 0;
   }
 
   // Output o's target as (array, index), false unless it reads NAME[digits].
   bool target(uint32_t o, std::string *array, long *index) const {
     const std::string &t = targets_[o];
     size_t open = t.find('[');
-    if (open == std::string::npos || t.back() != ']' || open + 2 > t.size() - 1) return false;
+    if (open == std::string::npos || open == 0 || t.back() != ']' || open + 2 >= t.size())
+      return false;
     for (size_t k = open + 1; k + 1 < t.size(); ++k)
       if (t[k] < '0' || t[k] > '9') return false;
     *array = t.substr(0, open);
@@ -296,75 +378,126 @@ private:
     return true;
   }
 
-  // Output step i as a chain over one block's values: appends its entries, sets block and
-  // negate; false if it is not one.
-  bool chain(const Step &step, int *block, bool *negate, std::vector<long> *entries) const {
+  // A term of an output's chain: the block's value it adds or subtracts.
+  struct Piece {
+    Origin origin;
+    bool minus;
+  };
+
+  // Output step `step` as a chain of + and - over the values of one block (sets *block
+  // when it is -1), its terms in the loop's order; false if it is not one.
+  bool chain(const Step &step, int *block, bool *negate, std::vector<Piece> *pieces) const {
     uint32_t t = step.term;
     *negate = s_.terms[t].kind == TermKind::Neg;
     if (*negate) t = s_.terms[t].args[0];
-    std::vector<long> rev;
-    auto element = [&](uint32_t leaf, long *e) {
+    std::vector<Piece> rev;
+    auto piece = [&](uint32_t leaf, bool minus) {
       const Term &term = s_.terms[leaf];
       if (term.kind != TermKind::Temp) return false;
-      auto w = where(term.temp);
-      if (w.first < 0 || (*block >= 0 && w.first != *block)) return false;
-      *block = w.first;
-      *e = w.second;
+      auto it = origin_.find(term.temp);
+      if (it == origin_.end() || (*block >= 0 && it->second.block != *block)) return false;
+      *block = it->second.block;
+      rev.push_back({it->second, minus});
       return true;
     };
     while (s_.terms[t].kind == TermKind::Add || s_.terms[t].kind == TermKind::Sub) {
       const Term &term = s_.terms[t];
-      long e;
-      if (!element(term.args[1], &e)) return false;
-      rev.push_back(term.kind == TermKind::Add ? e : ~e);
+      if (!piece(term.args[1], term.kind == TermKind::Sub)) return false;
       t = term.args[0];
     }
-    long e;
     bool neg = s_.terms[t].kind == TermKind::Neg;
-    if (!element(neg ? s_.terms[t].args[0] : t, &e)) return false;
-    rev.push_back(neg ? ~e : e);
-    entries->insert(entries->end(), rev.rbegin(), rev.rend());
+    if (!piece(neg ? s_.terms[t].args[0] : t, neg)) return false;
+    for (size_t k = rev.size(); k-- > 1;) {
+      const Origin &a = rev[k].origin, &b = rev[k - 1].origin;
+      if (a.instance > b.instance || (a.instance == b.instance && a.position >= b.position))
+        return false;
+    }
+    pieces->insert(pieces->end(), rev.rbegin(), rev.rend());
     return true;
   }
 
-  void find_gathers() {
+  // The runs of consecutive outputs the blocks can accumulate, entered in the plan; their
+  // steps.
+  std::unordered_set<size_t> find_scatters() {
+    std::unordered_set<size_t> steps;
     for (size_t i = 0; i < s_.steps.size();) {
-      LoopGather g;
-      g.first = i;
-      std::string array0;
-      long index0 = 0;
+      LoopScatter sc;
+      sc.first = i;
+      // per output, its pieces
+      std::vector<std::vector<Piece>> outs;
       for (size_t j = i; j < s_.steps.size(); ++j) {
         const Step &step = s_.steps[j];
         if (step.kind != StepKind::Output) break;
         std::string array;
         long index;
         if (!target(step.output, &array, &index)) break;
-        if (g.count == 0) {
-          array0 = array;
-          index0 = index;
-        } else if (array != array0 || index != index0 + long(g.count)) {
+        if (sc.count == 0) {
+          sc.array = array;
+          sc.index0 = index;
+        } else if (array != sc.array || index != sc.index0 + long(sc.count)) {
           break;
         }
-        int block = g.block;
+        int block = sc.block;
         bool negate;
-        size_t before = g.table.size();
-        if (!chain(step, &block, &negate, &g.table) || (g.count && negate != g.negate)) {
-          g.table.resize(before);
-          break;
-        }
-        g.block = block;
-        g.negate = negate;
-        g.start.push_back(long(before));
-        ++g.count;
+        std::vector<Piece> pieces;
+        if (!chain(step, &block, &negate, &pieces) || (sc.count && negate != sc.negate)) break;
+        sc.block = block;
+        sc.negate = negate;
+        outs.push_back(std::move(pieces));
+        ++sc.count;
       }
-      if (g.count >= 2 && g.table.size() >= kMinLoopSteps) {
-        g.start.push_back(long(g.table.size()));
-        i += g.count;
-        plan_.gathers.push_back(std::move(g));
+      if (sc.count >= 2 && uniform_terms(outs, &sc)) {
+        for (size_t j = i; j < i + sc.count; ++j)
+          steps.insert(j);
+        i += sc.count;
+        plan_.scatters.push_back(std::move(sc));
       } else {
         ++i;
       }
     }
+    return steps;
+  }
+
+  // Do the pieces of outs come, instance after instance, in one pattern: for each position
+  // the same number of outputs, with the same signs? Fills sc's terms if so.
+  bool uniform_terms(const std::vector<std::vector<Piece>> &outs, LoopScatter *sc) {
+    const LoopBlock &b = plan_.blocks[size_t(sc->block)];
+    size_t npos = b.positions();
+    // by instance and position: (output, minus), in output order
+    std::vector<std::vector<std::vector<std::pair<long, bool>>>> by(
+        b.count, std::vector<std::vector<std::pair<long, bool>>>(npos));
+    size_t total = 0;
+    for (size_t o = 0; o < outs.size(); ++o)
+      for (const Piece &p : outs[o]) {
+        by[p.origin.instance][p.origin.position].push_back({long(o), p.minus});
+        ++total;
+      }
+    if (total < kMinLoopSteps) return false;
+    for (size_t q = 0; q < npos; ++q) {
+      const auto &pattern = by[0][q];
+      for (size_t r = 0; r < pattern.size(); ++r) {
+        LoopScatter::Term term;
+        term.position = uint32_t(q);
+        term.minus = pattern[r].second;
+        std::vector<long> v;
+        for (size_t m = 0; m < b.count; ++m) {
+          const auto &here = by[m][q];
+          if (here.size() != pattern.size() || here[r].second != term.minus) return false;
+          v.push_back(here[r].first + sc->index0);
+        }
+        term.column = column(v, columns_[size_t(sc->block)], b.slots);
+        if (term.column.kind == LoopColumn::Affine || term.column.kind == LoopColumn::Offset) {
+          term.column.base -= sc->index0;
+        } else {
+          for (long &x : term.column.table)
+            x -= sc->index0;
+        }
+        sc->terms.push_back(std::move(term));
+      }
+      for (size_t m = 1; m < b.count; ++m)
+        if (by[m][q].size() != pattern.size()) return false;
+    }
+    return true;
   }
 
   const Schedule &s_;
@@ -372,6 +505,8 @@ private:
   const std::vector<std::string> &targets_;
   std::vector<long> def_;        // temp -> the step that computes it
   std::vector<size_t> last_use_; // temp -> the last step that reads it
+  std::unordered_map<uint32_t, Origin> origin_;
+  std::vector<std::vector<std::vector<long>>> columns_; // per block, its slots' indices
   size_t values_bytes_ = 0;
   LoopPlan plan_;
 };

@@ -5,7 +5,7 @@
 // element of an array (in[i], p[j]). Produces: a plan the C emitter (emit_c.cpp) prints as
 // loops over static tables of indices, so that N bodies cost O(N^2) table entries but O(1)
 // code. Every instance of a loop performs the very operations its unrolled steps would, in
-// the same order, and a gather adds its terms in the order of the unrolled sum: the loops
+// the same order, and an output sum adds its terms in the order of the unrolled sum: the loops
 // change the C's size, not one bit of what it computes, so the kernel interpreter
 // (kernel_interpreter.cpp), which runs the unrolled schedule, agrees with them.
 #pragma once
@@ -38,29 +38,50 @@ struct LoopSlot {
   LoopColumn column;
 };
 
-// Steps [first, first + period * count): `count` instances of `period` Define steps.
+// `count` instances of a body of Define steps: segment s contributes steps
+// [first_s + m * period_s, first_s + (m + 1) * period_s) to instance m, the segments one after
+// another in the schedule (a pair's distance, then its force), the body's positions numbered
+// across them.
 struct LoopBlock {
-  size_t first = 0, period = 0, count = 0;
+  std::vector<std::pair<size_t, size_t>> segments; // (first, period)
+  size_t count = 0;
   std::vector<LoopSlot> slots;
   std::unordered_map<uint32_t, int> leaf_slot;  // instance 0's leaf terms -> slots
   std::unordered_map<uint32_t, uint32_t> local; // instance 0's temp terms -> position
   std::vector<int> escape;                      // position -> index in the values array, or -1
   size_t nescape = 0;                           // values per instance kept after the loop
+  size_t positions() const {
+    size_t n = 0;
+    for (auto [first, period] : segments)
+      n += period;
+    return n;
+  }
+  size_t end() const { return segments.back().first + segments.back().second * count; }
 };
 
-// Output steps [first, first + count): out_index + o = (sign) sum of values of `block`, the
-// terms of output o being entries [start[o], start[o+1]) of `table` (e >= 0: + values[e];
-// e < 0: - values[~e]; the first entry starts the sum).
-struct LoopGather {
+// Output steps [first, first + count): array[index0 + o] = (-) the chain of + and - over the
+// values of `block` that the unrolled output sums, accumulated as the loop makes them: each
+// instance adds (or subtracts) its position `position`'s value to the output its column
+// names. The outputs start as -0.0, which a first term replaces exactly, and each output's
+// terms come in the loop's order (instance, then position), so the sums are the unrolled
+// ones, bit for bit.
+struct LoopScatter {
   size_t first = 0, count = 0;
   int block = -1;
   bool negate = false;
-  std::vector<long> table, start;
+  std::string array;
+  long index0 = 0;
+  struct Term {
+    uint32_t position = 0;
+    bool minus = false;
+    LoopColumn column; // o, per instance
+  };
+  std::vector<Term> terms;
 };
 
 struct LoopPlan {
   std::vector<LoopBlock> blocks;
-  std::vector<LoopGather> gathers;
+  std::vector<LoopScatter> scatters;
   // Temporaries kept in a block's values array: temp -> (block, element).
   std::unordered_map<uint32_t, std::pair<int, long>> home;
   bool empty() const { return blocks.empty(); }
@@ -70,7 +91,8 @@ struct LoopPlan {
 using SymbolIndex = std::function<bool(Symbol *, std::string *array, long *index)>;
 
 // The loops of s's repeated runs of at least kMinLoopInstances instances (see loops.cpp),
-// and the gathers of outputs whose targets (targets[j], "NAME[index]") are consecutive.
+// and the sums accumulated in them of outputs whose targets (targets[j], "NAME[index]")
+// are consecutive.
 LoopPlan plan_loops(const Schedule &s, const SymbolIndex &index_of,
                     const std::vector<std::string> &targets);
 
