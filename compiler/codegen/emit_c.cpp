@@ -5,6 +5,9 @@
 // this file only spells it, with parentheses exactly where C's precedence
 // would otherwise regroup an operation, so that the C compiler evaluates
 // each term as the kernel interpreter does (codegen/kernel_interpreter.hpp).
+// A kernel's runs of one shape over many index tuples are printed as loops
+// over index tables (codegen/loops.hpp): the same operations in the same
+// order, so the interpreter, which runs the unrolled schedule, still agrees.
 //
 // Temporaries are plain `double`, not `const double`: when optimizing,
 // gcc's C front end substitutes a const local's initializer wherever the
