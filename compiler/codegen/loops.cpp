@@ -19,11 +19,12 @@
 //
 // Limits, named below: a block needs kMinLoopInstances instances and kMinLoopSteps steps, so
 // that small kernels (a pendulum, up to 16 bodies) keep their straight-line C, which the C
-// compiler schedules best: measured with bench/scale against the hand-written pair loop,
+// compiler schedules best. Measured with bench/scale against the hand-written pair loop,
 // straight-line derivatives ran at 1.01x (10 bodies, 45 pairs) and 1.10x (16, 120) where
 // loops ran at 1.06-1.17x; at 20 bodies (190 pairs) straight-line was 1.20x and the loop
-// 1.02x, at 32 bodies 1.52x against 1.07x; runs of up to kMaxPeriod steps per instance are tried;
-// the values arrays live on the stack, kMaxValuesBytes in all. What does not fit stays unrolled.
+// 1.02x, at 32 bodies 1.52x against 1.07x. Runs of up to kMaxPeriod steps per instance are
+// tried. The values arrays live on the stack, kMaxValuesBytes in all (the N-body loop needs
+// none); a run that would need more stays unrolled.
 #include "codegen/loops.hpp"
 
 #include <algorithm>
@@ -38,7 +39,7 @@ namespace {
 constexpr size_t kMinLoopInstances = 128;
 constexpr size_t kMinLoopSteps = 128;
 constexpr size_t kMaxPeriod = 8;
-constexpr size_t kMaxValuesBytes = size_t(4) << 20;
+constexpr size_t kMaxValuesBytes = size_t(1) << 20;
 
 // One leaf of an instance: an array element, or a temporary computed before the instance.
 struct Leaf {
@@ -252,7 +253,7 @@ private:
   }
 
   // The longest block starting at step i, with the segments that follow it, entered in the
-  // plan; the step after it, or i if there is none.
+  // plan if it fits; the step after it, or i if there is none.
   size_t try_block(size_t i) {
     Segments best;
     std::vector<Instance> insts;
@@ -280,7 +281,10 @@ private:
         }
       }
     }
-    return enter_block(best, insts) ? best.back().first + best.back().second * count : i;
+    // A run refused stays unrolled as a whole: trying it again from each of its steps would
+    // cost its length squared.
+    enter_block(best, insts);
+    return best.back().first + best.back().second * count;
   }
 
   // The column of v (an index per instance), as an offset from one of `cols` (the block's
@@ -315,6 +319,8 @@ private:
     return c;
   }
 
+  // Enters the block of these instances in the plan, false if its values arrays would not
+  // fit under kMaxValuesBytes.
   bool enter_block(const Segments &segs, const std::vector<Instance> &insts) {
     LoopBlock b;
     b.segments = segs;
