@@ -24,6 +24,7 @@
 #include "codegen/emit_c.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -168,8 +169,19 @@ private:
     case LoopColumn::Affine: return affine(c.base, c.stride, k);
     case LoopColumn::Offset: return column(b, size_t(c.of), k) + plus(c.base);
     case LoopColumn::Table: return name("x", b) + "_" + std::to_string(j) + "[" + k + "]";
+    case LoopColumn::PairFirst: return affine(c.base, c.stride, name("i", b));
+    case LoopColumn::PairSecond: return affine(c.base, c.stride, name("j", b));
     }
     return "";
+  }
+
+  // Does text use the name `word` (not as the start of a longer name)?
+  static bool uses(const std::string &text, const std::string &word) {
+    for (size_t at = text.find(word); at != std::string::npos; at = text.find(word, at + 1)) {
+      char next = at + word.size() < text.size() ? text[at + word.size()] : ' ';
+      if (!(std::isalnum(static_cast<unsigned char>(next)) || next == '_')) return true;
+    }
+    return false;
   }
 
   // Each output of sc set to `prefix` itself (-0.0, or minus itself), as a loop.
@@ -202,8 +214,7 @@ private:
     if (blk.nescape)
       out += indent + "  double " + name("v", b) + "[" + std::to_string(blk.nescape * blk.count) +
              "];\n";
-    out += indent + "  for (int " + k + " = 0; " + k + " < " + std::to_string(blk.count) + "; ++" +
-           k + ") {\n";
+    std::string body;
     override_.clear();
     for (auto [term, slot] : blk.leaf_slot) {
       const LoopSlot &sl = blk.slots[size_t(slot)];
@@ -218,10 +229,10 @@ private:
     size_t q = 0;
     for (auto [first, period] : blk.segments)
       for (size_t r = 0; r < period; ++r, ++q) {
-        out += indent + "    double " + local(q) + " = " + text(s_.steps[first + r].term) + ";\n";
+        body += indent + "    double " + local(q) + " = " + text(s_.steps[first + r].term) + ";\n";
         if (blk.escape[q] >= 0)
-          out += indent + "    " + name("v", b) + "[" + std::to_string(blk.nescape) + " * " + k +
-                 " + " + std::to_string(blk.escape[q]) + "] = " + local(q) + ";\n";
+          body += indent + "    " + name("v", b) + "[" + std::to_string(blk.nescape) + " * " + k +
+                  " + " + std::to_string(blk.escape[q]) + "] = " + local(q) + ";\n";
       }
     override_.clear();
     // Each output's terms in position order, as its unrolled sum has them.
@@ -240,12 +251,31 @@ private:
           case LoopColumn::Table:
             idx = name("y", g) + "_" + std::to_string(r) + "[" + k + "]";
             break;
+          case LoopColumn::PairFirst:
+            idx = affine(term.column.base, term.column.stride, name("i", b));
+            break;
+          case LoopColumn::PairSecond:
+            idx = affine(term.column.base, term.column.stride, name("j", b));
+            break;
           }
           std::string t = sc->array + "[" + std::to_string(sc->index0) + " + " + idx + "]";
-          out +=
+          body +=
               indent + "    " + t + " = " + t + (term.minus ? " - " : " + ") + local(pos) + ";\n";
         }
       }
+    if (blk.pairs) {
+      // Two nested loops over i < j; k counts the pairs when something reads it.
+      std::string i = name("i", b), j = name("j", b), n = std::to_string(blk.pairs);
+      bool counted = uses(body, k);
+      if (counted) out += indent + "  int " + k + " = 0;\n";
+      out += indent + "  for (int " + i + " = 0; " + i + " < " + n + "; ++" + i + ")\n";
+      out += indent + "    for (int " + j + " = " + i + " + 1; " + j + " < " + n + "; ++" + j +
+             (counted ? ", ++" + k : "") + ") {\n";
+      return out + body + indent + "  }\n";
+    }
+    out += indent + "  for (int " + k + " = 0; " + k + " < " + std::to_string(blk.count) + "; ++" +
+           k + ") {\n";
+    out += body;
     return out + indent + "  }\n";
   }
 

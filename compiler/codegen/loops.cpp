@@ -302,7 +302,9 @@ private:
       return c;
     }
     for (size_t j = 0; j < cols.size(); ++j) {
-      if (slots[j].scalar >= 0 || slots[j].column.kind != LoopColumn::Table) continue;
+      LoopColumn::Kind kind = slots[j].column.kind;
+      if (slots[j].scalar >= 0 || kind == LoopColumn::Affine || kind == LoopColumn::Offset)
+        continue;
       long d = v[0] - cols[j][0];
       bool same = true;
       for (size_t k = 0; k < v.size() && same; ++k)
@@ -362,9 +364,63 @@ private:
         origin_[temp] = {id, m, uint32_t(q)};
         if (b.escape[q] >= 0) plan_.home[temp] = {id, long(m * b.nescape) + b.escape[q]};
       }
+    pair_columns(&b, cols);
     columns_.push_back(std::move(cols));
     plan_.blocks.push_back(std::move(b));
     return true;
+  }
+
+  // When the block's instances are the pairs i < j of some n in order and every table
+  // column is an affine function of i or of j (a pair's bodies), makes them so: the C is
+  // then two nested loops, O(1) in n, where the tables were O(n^2).
+  static void pair_columns(LoopBlock *b, const std::vector<std::vector<long>> &cols) {
+    size_t n = 2;
+    while (n * (n - 1) / 2 < b->count)
+      ++n;
+    if (n * (n - 1) / 2 != b->count) return;
+    std::vector<long> first, second;
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = i + 1; j < n; ++j) {
+        first.push_back(long(i));
+        second.push_back(long(j));
+      }
+    auto fits = [](const std::vector<long> &v, const std::vector<long> &index, long *base,
+                   long *stride) {
+      // v[k] = base + stride * index[k], index[0] = 0 and index running to at least 1.
+      *base = v[0];
+      size_t one = 0;
+      while (one < index.size() && index[one] == 0)
+        ++one;
+      if (one == index.size()) return false;
+      *stride = (v[one] - *base) / index[one];
+      for (size_t k = 0; k < v.size(); ++k)
+        if (v[k] != *base + *stride * index[k]) return false;
+      return true;
+    };
+    std::vector<LoopColumn> made(cols.size());
+    bool any = false;
+    for (size_t j = 0; j < cols.size(); ++j) {
+      if (b->slots[j].scalar >= 0 || b->slots[j].column.kind != LoopColumn::Table) continue;
+      LoopColumn &c = made[j];
+      // second[k] starts at 1: fit j - 1.
+      std::vector<long> second0(second.size());
+      for (size_t k = 0; k < second.size(); ++k)
+        second0[k] = second[k] - 1;
+      if (fits(cols[j], first, &c.base, &c.stride)) {
+        c.kind = LoopColumn::PairFirst;
+      } else if (fits(cols[j], second0, &c.base, &c.stride)) {
+        c.kind = LoopColumn::PairSecond;
+        c.base -= c.stride; // base + stride * j
+      } else {
+        return;
+      }
+      any = true;
+    }
+    if (!any) return;
+    for (size_t j = 0; j < cols.size(); ++j)
+      if (made[j].kind == LoopColumn::PairFirst || made[j].kind == LoopColumn::PairSecond)
+        b->slots[j].column = made[j];
+    b->pairs = n;
   }
 
   static size_t step_of(const Segments &segs, size_t m, size_t q) {

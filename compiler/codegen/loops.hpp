@@ -21,9 +21,10 @@
 namespace sicm {
 
 // Instance k's index of one leaf: base + stride * k, or column `of`'s index plus base, or
-// table[k].
+// table[k]; in a block over the pairs i < j (LoopBlock::pairs), base + stride * i or
+// base + stride * j.
 struct LoopColumn {
-  enum Kind : uint8_t { Affine, Offset, Table } kind = Affine;
+  enum Kind : uint8_t { Affine, Offset, Table, PairFirst, PairSecond } kind = Affine;
   long base = 0, stride = 0;
   int of = -1;
   std::vector<long> table;
@@ -50,6 +51,9 @@ struct LoopBlock {
   std::unordered_map<uint32_t, uint32_t> local; // instance 0's temp terms -> position
   std::vector<int> escape;                      // position -> index in the values array, or -1
   size_t nescape = 0;                           // values per instance kept after the loop
+  // When nonzero, instance k is the k-th pair (i, j), i < j < pairs, in the order
+  // (0, 1), (0, 2), ..., (1, 2), ...: the loop is two nested loops and needs no tables.
+  size_t pairs = 0;
   size_t positions() const {
     size_t n = 0;
     for (auto [first, period] : segments)
