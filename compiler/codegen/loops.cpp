@@ -11,7 +11,9 @@
 // joins it as a second segment of the same loop body (the distances and the forces of a
 // pair in one iteration). Each slot's indices over the instances are a column: affine in
 // the instance number, a constant offset from an earlier column (y_i beside x_i, or the
-// output of body i beside its input), or a static table. Values an instance computes that
+// output of body i beside its input), or a static table; when the instances are the pairs
+// i < j of n bodies in order and each table is affine in i or in j, the loop is two nested
+// loops over i and j and needs no table. Values an instance computes that
 // later steps read are kept in one array per block; the rest stay locals of the loop body.
 // Outputs that are each a chain of + and - over one block's values, with every output's
 // terms in the loop's order, are accumulated by the loop (LoopScatter), as a hand-written

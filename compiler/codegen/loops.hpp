@@ -3,9 +3,9 @@
 //
 // Requires: an unchecked Schedule (codegen/schedule.hpp) and a way to name each symbol as an
 // element of an array (in[i], p[j]). Produces: a plan the C emitter (emit_c.cpp) prints as
-// loops over static tables of indices, so that N bodies cost O(N^2) table entries but O(1)
-// code. Every instance of a loop performs the very operations its unrolled steps would, in
-// the same order, and an output sum adds its terms in the order of the unrolled sum: the loops
+// loops over static tables of indices, or over the pairs i < j with none, so that N bodies
+// cost O(1) code. Every instance of a loop performs the very operations its unrolled steps would,
+// in the same order, and an output sum adds its terms in the order of the unrolled sum: the loops
 // change the C's size, not one bit of what it computes, so the kernel interpreter
 // (kernel_interpreter.cpp), which runs the unrolled schedule, agrees with them.
 #pragma once
