@@ -5,6 +5,9 @@
 // this file only spells it, with parentheses exactly where C's precedence
 // would otherwise regroup an operation, so that the C compiler evaluates
 // each term as the kernel interpreter does (codegen/kernel_interpreter.hpp).
+// A kernel's runs of one shape over many index tuples are printed as loops
+// over index tables (codegen/loops.hpp): the same operations in the same
+// order, so the interpreter, which runs the unrolled schedule, still agrees.
 //
 // Temporaries are plain `double`, not `const double`: when optimizing,
 // gcc's C front end substitutes a const local's initializer wherever the
@@ -21,6 +24,7 @@
 #include "codegen/emit_c.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -32,6 +36,7 @@
 #include "algebra/linear_solve.hpp"
 #include "base/error.hpp"
 #include "codegen/jit.hpp"
+#include "codegen/loops.hpp"
 #include "codegen/schedule.hpp"
 #include "sicm/runtime.h"
 
@@ -51,11 +56,31 @@ public:
           const std::function<std::string(ExprId)> &site_of = nullptr)
       : s_(s), spell_(spell), prefix_(prefix), site_(site), site_of_(site_of) {}
 
-  // The steps, each line starting with indent, outputs into targets.
-  std::string statements(const std::vector<std::string> &targets, const std::string &indent) {
+  // The steps, each line starting with indent, outputs into targets; runs of repeated
+  // steps as loops when index_of names the symbols as array elements (codegen/loops.hpp).
+  std::string statements(const std::vector<std::string> &targets, const std::string &indent,
+                         const SymbolIndex *index_of = nullptr) {
     std::string out;
     auto line = [&](const std::string &text) { out += indent + text + "\n"; };
-    for (const Step &step : s_.steps) {
+    if (index_of && site_.empty()) plan_ = plan_loops(s_, *index_of, targets);
+    std::unordered_map<size_t, size_t> block_at, scatter_at;
+    for (size_t b = 0; b < plan_.blocks.size(); ++b)
+      block_at[plan_.blocks[b].segments[0].first] = b;
+    for (size_t g = 0; g < plan_.scatters.size(); ++g)
+      scatter_at[plan_.scatters[g].first] = g;
+    for (size_t i = 0; i < s_.steps.size(); ++i) {
+      if (auto b = block_at.find(i); b != block_at.end()) {
+        out += block(b->second, indent);
+        i = plan_.blocks[b->second].end() - 1;
+        continue;
+      }
+      if (auto g = scatter_at.find(i); g != scatter_at.end()) {
+        const LoopScatter &sc = plan_.scatters[g->second];
+        if (sc.negate) out += outputs_loop(sc, indent, "-");
+        i += sc.count - 1;
+        continue;
+      }
+      const Step &step = s_.steps[i];
       std::string t = temp(step.temp), n = std::to_string(step.n);
       switch (step.kind) {
       case StepKind::Define: line("  double " + t + " = " + text(step.term) + ";"); break;
@@ -115,6 +140,144 @@ public:
 
 private:
   std::string temp(uint32_t n) const { return prefix_ + std::to_string(n); }
+  std::string name(const char *what, size_t n) const { return prefix_ + what + std::to_string(n); }
+
+  // A static table of ints, sixteen to a line.
+  static std::string table(const std::string &name, const std::vector<long> &v,
+                           const std::string &indent) {
+    std::string s =
+        indent + "  static const int " + name + "[" + std::to_string(v.size()) + "] = {";
+    for (size_t k = 0; k < v.size(); ++k)
+      s += (k % 16 ? " " : "\n" + indent + "    ") + std::to_string(v[k]) + ",";
+    return s + "\n" + indent + "  };\n";
+  }
+
+  static std::string affine(long base, long stride, const std::string &k) {
+    if (stride == 0) return std::to_string(base);
+    std::string s = stride == 1 ? k : std::to_string(stride) + " * " + k;
+    return base == 0 ? s : std::to_string(base) + " + " + s;
+  }
+  static std::string plus(long d) {
+    if (d == 0) return "";
+    return (d < 0 ? " - " : " + ") + std::to_string(d < 0 ? -d : d);
+  }
+
+  // Instance k's index of slot j of block b, as C.
+  std::string column(size_t b, size_t j, const std::string &k) const {
+    const LoopColumn &c = plan_.blocks[b].slots[j].column;
+    switch (c.kind) {
+    case LoopColumn::Affine: return affine(c.base, c.stride, k);
+    case LoopColumn::Offset: return column(b, size_t(c.of), k) + plus(c.base);
+    case LoopColumn::Table: return name("x", b) + "_" + std::to_string(j) + "[" + k + "]";
+    case LoopColumn::PairFirst: return affine(c.base, c.stride, name("i", b));
+    case LoopColumn::PairSecond: return affine(c.base, c.stride, name("j", b));
+    }
+    return "";
+  }
+
+  // Does text use the name `word` (not as the start of a longer name)?
+  static bool uses(const std::string &text, const std::string &word) {
+    for (size_t at = text.find(word); at != std::string::npos; at = text.find(word, at + 1)) {
+      char next = at + word.size() < text.size() ? text[at + word.size()] : ' ';
+      if (!(std::isalnum(static_cast<unsigned char>(next)) || next == '_')) return true;
+    }
+    return false;
+  }
+
+  // Each output of sc set to `prefix` itself (-0.0, or minus itself), as a loop.
+  std::string outputs_loop(const LoopScatter &sc, const std::string &indent,
+                           const std::string &prefix) {
+    std::string o = name("o", &sc - plan_.scatters.data());
+    std::string t = sc.array + "[" + std::to_string(sc.index0) + " + " + o + "]";
+    return indent + "  for (int " + o + " = 0; " + o + " < " + std::to_string(sc.count) + "; ++" +
+           o + ")\n" + indent + "    " + t + " = " + (prefix == "-" ? "-" + t : prefix) + ";\n";
+  }
+
+  // Block b as a loop over its instances, its escaping values into its array and the
+  // outputs it accumulates.
+  std::string block(size_t b, const std::string &indent) {
+    const LoopBlock &blk = plan_.blocks[b];
+    std::string out, k = name("k", b);
+    for (size_t j = 0; j < blk.slots.size(); ++j)
+      if (blk.slots[j].scalar < 0 && blk.slots[j].column.kind == LoopColumn::Table)
+        out += table(name("x", b) + "_" + std::to_string(j), blk.slots[j].column.table, indent);
+    std::vector<const LoopScatter *> scatters;
+    for (const LoopScatter &sc : plan_.scatters)
+      if (sc.block == int(b)) {
+        scatters.push_back(&sc);
+        for (size_t r = 0; r < sc.terms.size(); ++r)
+          if (sc.terms[r].column.kind == LoopColumn::Table)
+            out += table(name("y", size_t(&sc - plan_.scatters.data())) + "_" + std::to_string(r),
+                         sc.terms[r].column.table, indent);
+        out += outputs_loop(sc, indent, "-0.0");
+      }
+    if (blk.nescape)
+      out += indent + "  double " + name("v", b) + "[" + std::to_string(blk.nescape * blk.count) +
+             "];\n";
+    std::string body;
+    override_.clear();
+    for (auto [term, slot] : blk.leaf_slot) {
+      const LoopSlot &sl = blk.slots[size_t(slot)];
+      override_[term] = sl.scalar >= 0 ? temp(uint32_t(sl.scalar))
+                        : sl.block >= 0
+                            ? name("v", size_t(sl.block)) + "[" + column(b, size_t(slot), k) + "]"
+                            : sl.array + "[" + column(b, size_t(slot), k) + "]";
+    }
+    auto local = [&](size_t q) { return name("l", b) + "_" + std::to_string(q); };
+    for (auto [term, q] : blk.local)
+      override_[term] = local(q);
+    size_t q = 0;
+    for (auto [first, period] : blk.segments)
+      for (size_t r = 0; r < period; ++r, ++q) {
+        body += indent + "    double " + local(q) + " = " + text(s_.steps[first + r].term) + ";\n";
+        if (blk.escape[q] >= 0)
+          body += indent + "    " + name("v", b) + "[" + std::to_string(blk.nescape) + " * " + k +
+                  " + " + std::to_string(blk.escape[q]) + "] = " + local(q) + ";\n";
+      }
+    override_.clear();
+    // Each output's terms in position order, as its unrolled sum has them.
+    for (size_t pos = 0; pos < q; ++pos)
+      for (const LoopScatter *sc : scatters) {
+        size_t g = size_t(sc - plan_.scatters.data());
+        for (size_t r = 0; r < sc->terms.size(); ++r) {
+          const LoopScatter::Term &term = sc->terms[r];
+          if (term.position != pos) continue;
+          std::string idx;
+          switch (term.column.kind) {
+          case LoopColumn::Affine: idx = affine(term.column.base, term.column.stride, k); break;
+          case LoopColumn::Offset:
+            idx = column(b, size_t(term.column.of), k) + plus(term.column.base);
+            break;
+          case LoopColumn::Table:
+            idx = name("y", g) + "_" + std::to_string(r) + "[" + k + "]";
+            break;
+          case LoopColumn::PairFirst:
+            idx = affine(term.column.base, term.column.stride, name("i", b));
+            break;
+          case LoopColumn::PairSecond:
+            idx = affine(term.column.base, term.column.stride, name("j", b));
+            break;
+          }
+          std::string t = sc->array + "[" + std::to_string(sc->index0) + " + " + idx + "]";
+          body +=
+              indent + "    " + t + " = " + t + (term.minus ? " - " : " + ") + local(pos) + ";\n";
+        }
+      }
+    if (blk.pairs) {
+      // Two nested loops over i < j; k counts the pairs when something reads it.
+      std::string i = name("i", b), j = name("j", b), n = std::to_string(blk.pairs);
+      bool counted = uses(body, k);
+      if (counted) out += indent + "  int " + k + " = 0;\n";
+      out += indent + "  for (int " + i + " = 0; " + i + " < " + n + "; ++" + i + ")\n";
+      out += indent + "    for (int " + j + " = " + i + " + 1; " + j + " < " + n + "; ++" + j +
+             (counted ? ", ++" + k : "") + ") {\n";
+      return out + body + indent + "  }\n";
+    }
+    out += indent + "  for (int " + k + " = 0; " + k + " < " + std::to_string(blk.count) + "; ++" +
+           k + ") {\n";
+    out += body;
+    return out + indent + "  }\n";
+  }
 
   std::string list(const std::vector<uint32_t> &terms) {
     std::string s;
@@ -162,11 +325,16 @@ private:
   }
 
   std::string text(uint32_t t) {
+    if (!override_.empty())
+      if (auto it = override_.find(t); it != override_.end()) return it->second;
     const Term &term = s_.terms[t];
     switch (term.kind) {
     case TermKind::Literal: return term.text;
     case TermKind::Symbol: return spell_(term.symbol);
-    case TermKind::Temp: return temp(term.temp);
+    case TermKind::Temp:
+      if (auto it = plan_.home.find(term.temp); it != plan_.home.end())
+        return name("v", size_t(it->second.first)) + "[" + std::to_string(it->second.second) + "]";
+      return temp(term.temp);
     case TermKind::Element: return temp(term.temp) + "[" + std::to_string(term.element) + "]";
     case TermKind::Paren: return "(" + text(term.args[0]) + ")";
     case TermKind::Neg: return "-" + wrap(term.args[0], kAtom);
@@ -199,6 +367,8 @@ private:
   const std::function<std::string(Symbol *)> &spell_;
   const std::string &prefix_, &site_;
   const std::function<std::string(ExprId)> &site_of_;
+  LoopPlan plan_;
+  std::unordered_map<uint32_t, std::string> override_; // a loop body's leaves
 };
 
 } // namespace
@@ -289,7 +459,21 @@ std::string emit_kernel_function(const Trace &t, const std::string &c_name, bool
   std::vector<std::string> targets;
   for (size_t j = 0; j < t.outputs.size(); ++j)
     targets.push_back("out[" + std::to_string(j) + "]");
-  std::string body = Printer(schedule_outputs(t.outputs), spell, "t", "").statements(targets, "");
+  SymbolIndex index_of = [&](Symbol *s, std::string *array, long *index) {
+    auto k = param.find(s);
+    if (k != param.end()) {
+      *array = "p";
+      *index = long(k->second);
+      return true;
+    }
+    auto in = input.find(s);
+    if (in == input.end()) return false;
+    *array = "in";
+    *index = long(in->second);
+    return true;
+  };
+  std::string body =
+      Printer(schedule_outputs(t.outputs), spell, "t", "").statements(targets, "", &index_of);
   std::string f = is_static ? "static " : "";
   f += "void " + c_name + "(const double *in, double *out, const double *p) {\n";
   if (!uses_in) f += "  (void)in;\n";
@@ -305,9 +489,11 @@ std::string emit_c_assignments(const std::vector<ExprId> &values,
                                const std::function<std::string(Symbol *)> &spell,
                                const std::string &temp_prefix, const std::string &indent,
                                const std::string &checked_site,
-                               const std::function<std::string(ExprId)> &site_of) {
+                               const std::function<std::string(ExprId)> &site_of,
+                               const SymbolIndex *index_of) {
   Schedule s = schedule_outputs(values, !checked_site.empty());
-  return Printer(s, spell, temp_prefix, checked_site, site_of).statements(targets, indent);
+  return Printer(s, spell, temp_prefix, checked_site, site_of)
+      .statements(targets, indent, index_of);
 }
 
 bool uses_linear_solve(const std::vector<ExprId> &outputs) {

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "codegen/loops.hpp"
 #include "codegen/trace.hpp"
 
 namespace sicm {
@@ -37,12 +38,15 @@ std::string emit_kernel_unit(const Trace &t, const std::string &c_name,
 // program's own arithmetic); kernels pass none. site_of, when given, names
 // the site of a checked operation's node instead (the call that made it:
 // the `/` of `(/ 1 x)`, as sicm run reports it), or "" for checked_site.
+// With index_of (unchecked code only), runs of repeated steps become loops over tables
+// (codegen/loops.hpp); the symbols in them are written as index_of names them.
 std::string emit_c_assignments(const std::vector<ExprId> &values,
                                const std::vector<std::string> &targets,
                                const std::function<std::string(Symbol *)> &spell,
                                const std::string &temp_prefix, const std::string &indent,
                                const std::string &checked_site = "",
-                               const std::function<std::string(ExprId)> &site_of = nullptr);
+                               const std::function<std::string(ExprId)> &site_of = nullptr,
+                               const SymbolIndex *index_of = nullptr);
 
 // Does any output depend on a solve node (algebra/linear_solve.hpp)?
 bool uses_linear_solve(const std::vector<ExprId> &outputs);

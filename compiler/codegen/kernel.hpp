@@ -13,7 +13,8 @@
 //               expressions over the input symbols)
 //   emit_c.cpp  the Trace as one C11 function with the kernel ABI, after CSE,
 //               powers as products, sin/cos pairs as sincos and linear
-//               solves as LDL^T or LU factorizations
+//               solves as LDL^T or LU factorizations, runs of one shape over
+//               many index tuples as loops over index tables (loops.hpp)
 //   jit.cpp     the C compiled by the system compiler into a shared object,
 //               cached by content hash, and loaded with dlopen
 //

@@ -943,10 +943,35 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
       std::vector<std::string> targets;
       for (size_t j = 0; j < fn.outputs.size(); ++j)
         targets.push_back("out[" + std::to_string(j) + "]");
-      code += fn.kernel && fn.body.empty()
-                  ? emit_c_assignments(
-                        fn.outputs, targets, [this](Symbol *s) { return spell(s); }, "o", "")
-                  : checked_assignments(fn.outputs, targets, "o", fn.loc);
+      if (fn.kernel && fn.body.empty()) {
+        // A loop (codegen/loops.hpp) reads its inputs and captures from in[] and p[].
+        std::map<int, std::pair<const char *, long>> place;
+        for (size_t i = 0; i < fn.inputs.size(); ++i)
+          place.emplace(fn.inputs[i], std::make_pair("in", long(i)));
+        long k = 0;
+        for (int v : captures_[f])
+          place.emplace(v, std::make_pair("p", k++));
+        SymbolIndex index_of = [&](Symbol *s, std::string *array, long *index) {
+          auto it = place.find(var_id(s));
+          if (it == place.end()) return false;
+          *array = it->second.first;
+          *index = it->second.second;
+          return true;
+        };
+        std::string assignments = emit_c_assignments(
+            fn.outputs, targets, [this](Symbol *s) { return spell(s); }, "o", "", "", nullptr,
+            &index_of);
+        // The locals the loops no longer read are still declared above.
+        if (assignments.find("  for (") != std::string::npos) {
+          for (int v : fn.inputs)
+            if (used_[f].count(v)) code += "  (void)" + var_name(v) + ";\n";
+          for (int v : captures_[f])
+            code += "  (void)" + var_name(v) + ";\n";
+        }
+        code += assignments;
+      } else {
+        code += checked_assignments(fn.outputs, targets, "o", fn.loc);
+      }
     }
     return code + "}\n\n";
   }
