@@ -66,10 +66,11 @@ const CrossingEvent *as_crossing_event(Value v) {
   return static_cast<const CrossingEvent *>(v.as<Opaque>()->obj);
 }
 
-int arguments_before_events(Value *a, int n, const char *who) {
+int arguments_before_events(Value *a, int n, int required, const char *who) {
   int first = 0;
   while (first < n && !as_crossing_event(a[first]))
     ++first;
+  if (first < n && first < required) wrong_type(a[first], first + 1, who);
   for (int i = first; i < n; ++i)
     if (!as_crossing_event(a[i])) wrong_type(a[i], i + 1, who);
   return first;

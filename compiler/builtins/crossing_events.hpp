@@ -21,8 +21,11 @@ const CrossingEvent *as_crossing_event(Value v);
 
 // The number of arguments in a[0 .. n) before the first crossing event:
 // those the primitive's signature checks. Every argument after it must be
-// a crossing event too (else the wrong-type error of `who`'s call names it).
-int arguments_before_events(Value *a, int n, const char *who);
+// a crossing event too, and none may stand where one of the `required`
+// arguments should (else the wrong-type error of `who`'s call names it: an
+// event given in place of evolve's final time is the fourth argument of
+// the wrong type, not a call with too few arguments).
+int arguments_before_events(Value *a, int n, int required, const char *who);
 
 // The runtime's direction of an event (SICM_ODE_EVENT_UP, _DOWN or _BOTH).
 int crossing_direction(const CrossingEvent &e);

@@ -747,7 +747,7 @@ unsigned long optional_max_steps(Value *a, int n, int i) {
 // stops it.
 Value advance_state(NativeProc *self, Value *a, int all) {
   static const char who[] = "state-advancer";
-  const int n = arguments_before_events(a, all, who);
+  const int n = arguments_before_events(a, all, 2, who);
   check_numeric_arguments(who, a, n, self);
   SrcLoc loc = current_call_loc();
   double dt = real_at(a, 1);
@@ -783,7 +783,7 @@ Value P_state_advancer(Value *a, int n) {
 // at the crossing of an event that stops the integration.
 Value run_evolve(NativeProc *self, Value *a, int all) {
   static const char who[] = "evolve";
-  const int n = arguments_before_events(a, all, who);
+  const int n = arguments_before_events(a, all, 4, who);
   check_numeric_arguments(who, a, n, self);
   SrcLoc loc = current_call_loc();
   check_monitor_arity(loc, who, a[1]);

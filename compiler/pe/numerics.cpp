@@ -808,7 +808,7 @@ void trace_events(Value *a, int n, int all, Value state, RStmt &s, const char *w
 
 Value advance(NativeProc *self, Value *a, int all) {
   static const char who[] = "state-advancer";
-  const int n = arguments_before_events(a, all, who);
+  const int n = arguments_before_events(a, all, 2, who);
   check_numeric_arguments(who, a, n, self);
   RStmt s{RKind::Advance};
   s.loc = here();
@@ -835,7 +835,7 @@ Value P_state_advancer(Value *a, int n) {
 
 Value run_evolve(NativeProc *self, Value *a, int all) {
   static const char who[] = "evolve";
-  const int n = arguments_before_events(a, all, who);
+  const int n = arguments_before_events(a, all, 4, who);
   check_numeric_arguments(who, a, n, self);
   check_monitor_arity(here(), who, a[1]);
   Checkpoint before; // for a monitor whose trace fails (below)
