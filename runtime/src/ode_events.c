@@ -291,29 +291,34 @@ static int step_is_free(step_data *d) {
   cubic(d, 0.5, y, NULL);
   for (size_t i = 0; i < o->dim; i++)
     moved[i] = y[i] + f[i];
+  /* Each event's margin, then each sample of the cubic once for all the
+   * events (the samples' slots are free until the search). */
   int *last = o->event_sign_scratch;
+  double *margin = sample_values(o);
+  const double tm = d->ta + 0.5 * h;
   for (size_t k = 0; k < n; k++) {
-    const double tm = d->ta + 0.5 * h;
-    const double margin = fabs(event_value(o, k, tm, moved) - event_value(o, k, tm, y));
-    if (!isfinite(margin)) return 0;
-    int sign = o->event_sign[k];
-    for (int j = 1; j <= kSamples; j++) {
-      double g;
-      if (j == kSamples) {
-        g = event_value(o, k, d->tb, d->yb);
-      } else {
-        cubic(d, (double)j / kSamples, y, NULL);
-        g = event_value(o, k, d->ta + j * h / kSamples, y);
-      }
-      if (!isfinite(g) || fabs(g) <= margin) return 0;
+    margin[k] = fabs(event_value(o, k, tm, moved) - event_value(o, k, tm, y));
+    if (!isfinite(margin[k])) return 0;
+    last[k] = o->event_sign[k];
+  }
+  for (int j = 1; j <= kSamples; j++) {
+    const double *yj = d->yb;
+    double tj = d->tb;
+    if (j < kSamples) {
+      cubic(d, (double)j / kSamples, y, NULL);
+      yj = y;
+      tj = d->ta + j * h / kSamples;
+    }
+    for (size_t k = 0; k < n; k++) {
+      const double g = event_value(o, k, tj, yj);
+      if (!isfinite(g) || fabs(g) <= margin[k]) return 0;
       /* A change of sign in the direction asked for needs the search; one
        * the other way only changes the sign the next step starts from. */
-      if (sign_of(g) != sign &&
+      if (sign_of(g) != last[k] &&
           (o->events[k].direction & (g > 0 ? SICM_ODE_EVENT_UP : SICM_ODE_EVENT_DOWN)))
         return 0;
-      sign = sign_of(g);
+      last[k] = sign_of(g);
     }
-    last[k] = sign;
   }
   memcpy(o->event_sign, last, n * sizeof *last);
   return 1;

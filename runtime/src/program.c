@@ -608,11 +608,13 @@ typedef struct {
   int stopped;
 } event_sink;
 
-static double drive_event_of(double t, const double *y, void *c) {
+/* An event's value: its closure (c) of the state, one number out; the
+ * runtime's event function for evolve's, a state advance's and crossings'. */
+static double closure_event_value(double t, const double *y, void *c) {
   (void)t;
-  const sicm_drive_event *e = c;
+  const sicm_closure *event = c;
   double out;
-  e->event.fn(y, &out, e->event.p);
+  event->fn(y, &out, event->p);
   return out;
 }
 
@@ -637,7 +639,8 @@ static void set_drive_events(const sicm_site *site, const char *who, integrator 
   sicm_ode_event *table = malloc(n * sizeof *table);
   if (!table) sicm_program_fail(site, who, "out of memory");
   for (size_t i = 0; i < n; ++i)
-    table[i] = (sicm_ode_event){drive_event_of, (void *)&events[i], events[i].direction, 0};
+    table[i] =
+        (sicm_ode_event){closure_event_value, (void *)&events[i].event, events[i].direction, 0};
   const int status = sicm_ode_set_events(it->o, table, n, on_drive_event, sink);
   free(table); /* sicm_ode_set_events copied it */
   if (status) fail_with_status(site, who);
@@ -704,14 +707,6 @@ typedef struct {
   long count, found;
 } crossing_sink;
 
-static double event_of(double t, const double *y, void *c) {
-  (void)t;
-  const crossing_sink *sink = c;
-  double out;
-  sink->event.fn(y, &out, sink->event.p);
-  return out;
-}
-
 static int push_crossing(size_t event, double t, const double *y, void *c) {
   (void)event;
   (void)t;
@@ -730,7 +725,7 @@ void sicm_drive_crossings(const sicm_site *site, const sicm_drive_ode *ode, sicm
   integrator it;
   open_integrator(site, who, ode, &it);
   crossing_sink sink = {event, site, list, count, 0};
-  const sicm_ode_event e = {event_of, &sink, direction, 0};
+  const sicm_ode_event e = {closure_event_value, &sink.event, direction, 0};
   if (sicm_ode_set_events(it.o, &e, 1, push_crossing, &sink)) fail_with_status(site, who);
   double t = start_time(ode, state);
   evolve_to(site, who, &it, &t, t_final, state);
