@@ -125,9 +125,8 @@ const OpaqueKind kRtListKind = {"run-time-list", write_rtlist, nullptr};
 // Does the expression mention a residual variable? (Memoized: the arena
 // only grows and nodes never change.)
 bool expr_is_dynamic(ExprId root) {
-  std::unordered_map<ExprId, bool> &memo = g_build->dynamic_memo;
-  auto hit = memo.find(root);
-  if (hit != memo.end()) return hit->second;
+  std::vector<uint8_t> &memo = g_build->dynamic_memo;
+  if (root < memo.size() && memo[root] != 0) return memo[root] == 2;
   bool dynamic = false;
   const ExprNode &n = expr_node(root);
   switch (n.kind) {
@@ -136,41 +135,46 @@ bool expr_is_dynamic(ExprId root) {
   case ExprKind::Symbol: dynamic = g_build->var_ids.count(n.sym) > 0; break;
   case ExprKind::Apply:
   case ExprKind::Call: {
-    std::vector<ExprId> args = expr_arg_vector(root);
-    if (n.kind == ExprKind::Call) args.push_back(n.head);
-    for (ExprId a : args)
-      if (expr_is_dynamic(a)) {
-        dynamic = true;
-        break;
-      }
+    dynamic = n.kind == ExprKind::Call && expr_is_dynamic(n.head);
+    const ExprId *args = expr_args(root);
+    for (uint32_t i = 0; i < n.nargs && !dynamic; ++i)
+      dynamic = expr_is_dynamic(args[i]);
     break;
   }
   }
-  memo[root] = dynamic;
+  if (memo.size() <= root) memo.resize(expr_count() + 1024, 0);
+  memo[root] = dynamic ? 2 : 1;
   return dynamic;
 }
 
 // How a number, truth value or run-time value would be printed: an
 // expression of counts (exact integers combined by + and *) is a count.
 RType expr_type(ExprId id) {
+  std::vector<uint8_t> &memo = g_build->type_memo;
+  if (id < memo.size() && memo[id] != 0) return static_cast<RType>(memo[id] - 1);
   const ExprNode &n = expr_node(id);
+  RType type = RType::Real;
   switch (n.kind) {
-  case ExprKind::Rational: return expr_is_exact_integer(id) ? RType::Integer : RType::Real;
-  case ExprKind::Flonum: return RType::Real;
+  case ExprKind::Rational: type = expr_is_exact_integer(id) ? RType::Integer : RType::Real; break;
+  case ExprKind::Flonum: break;
   case ExprKind::Symbol: {
     auto it = g_build->var_ids.find(n.sym);
-    return it == g_build->var_ids.end() ? RType::Real : g_build->program.vars[it->second].type;
+    if (it != g_build->var_ids.end()) type = g_build->program.vars[it->second].type;
+    break;
   }
   case ExprKind::Apply:
     if (n.op == Op::Add || n.op == Op::Mul) {
-      for (ExprId a : expr_arg_vector(id))
-        if (expr_type(a) != RType::Integer) return RType::Real;
-      return RType::Integer;
+      type = RType::Integer;
+      const ExprId *args = expr_args(id);
+      for (uint32_t i = 0; i < n.nargs && type == RType::Integer; ++i)
+        if (expr_type(args[i]) != RType::Integer) type = RType::Real;
     }
-    return RType::Real;
-  case ExprKind::Call: return RType::Real;
+    break;
+  case ExprKind::Call: break;
   }
-  return RType::Real;
+  if (memo.size() <= id) memo.resize(expr_count() + 1024, 0);
+  memo[id] = static_cast<uint8_t>(static_cast<uint8_t>(type) + 1);
+  return type;
 }
 
 } // namespace

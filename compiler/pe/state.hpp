@@ -62,7 +62,9 @@ struct BuildState {
   // ---- pe/build_mode.cpp
   std::vector<int> open;                         // functions being traced, innermost last
   std::unordered_map<Symbol *, int> var_ids;     // residual variable of a symbol
-  std::unordered_map<ExprId, bool> dynamic_memo; // does an expression mention a variable?
+  // Per expression node (indexed by ExprId; 0 not yet known): does it
+  // mention a variable (1 no, 2 yes), and its RType plus 1 (expr_type).
+  std::vector<uint8_t> dynamic_memo, type_memo;
   // Tests on run-time values whose alternatives are being evaluated, nested,
   // in the innermost traced function.
   int branch_depth = 0;
