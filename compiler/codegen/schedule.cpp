@@ -264,6 +264,15 @@ private:
            expr_kind(expr_arg(id, 1)) == ExprKind::Symbol;
   }
 
+  // (sqrt u)^n for an odd |n| >= 3 is written u^((|n| - 1)/2) sqrt(u) (see
+  // power): one multiplication fewer than the cube of the root, and one
+  // rounding fewer (the 1/r^3 of a gravitational force is 1/(r2 sqrt(r2))).
+  static bool odd_power_of_root(ExprId id) {
+    int64_t n;
+    return integer_power(id, &n) && n % 2 != 0 && (n >= 3 || n <= -3) &&
+           expr_is_apply(expr_arg(id, 0), Op::Sqrt);
+  }
+
   void want_operand(ExprId id) {
     if (expr_kind(id) == ExprKind::Apply) wants_name_.insert(id);
   }
@@ -276,7 +285,10 @@ private:
       if (expr_kind(id) != ExprKind::Apply || is_constant_form(id)) continue;
       if (uses_[id] >= 2 && !is_input_negation(id)) wants_name_.insert(id);
       int64_t n;
-      if (integer_power(id, &n) && (n >= 2 || n <= -2)) want_operand(expr_arg(id, 0));
+      if (integer_power(id, &n) && (n >= 2 || n <= -2)) {
+        want_operand(expr_arg(id, 0));
+        if (odd_power_of_root(id)) want_operand(expr_arg(expr_arg(id, 0), 0));
+      }
       if (expr_is_apply(id, Op::Sin)) sin_of[expr_arg(id, 0)] = id;
       if (expr_is_apply(id, Op::Cos)) cos_of[expr_arg(id, 0)] = id;
     }
@@ -539,6 +551,11 @@ private:
     auto hit = powers_.find({base, m});
     if (hit != powers_.end()) return hit->second;
     if (m > kMaxSquaringPower) return libm_power(base, m);
+    if (m % 2 == 1 && expr_is_apply(base, Op::Sqrt)) { // see odd_power_of_root
+      ExprId radicand = expr_arg(base, 0);
+      uint32_t r = m == 3 ? operand(radicand) : power(radicand, m / 2);
+      return binary(TermKind::Mul, r, operand(base));
+    }
     uint32_t b = operand(base);
     if (m == 2) return binary(TermKind::Mul, b, b);
     if (m == 3) {
