@@ -41,9 +41,12 @@ using SymbolSpeller = std::function<std::string(Symbol *)>;
 // The C function described above, or "" with a one-line reason in *why_not
 // when an operation of the trace has no recurrence here or it holds a
 // symbol that is not an input and that spell does not spell.
+// known_order: the order the integration will ask for, when known (a
+// built program's tolerance is), else 0; the function then also holds a
+// faster path for that order (same operations, same results).
 std::string emit_taylor_function(const Trace &t, const std::string &c_name, std::string *why_not,
                                  TaylorPrecision precision = TaylorPrecision::Double,
-                                 const SymbolSpeller &spell = nullptr);
+                                 const SymbolSpeller &spell = nullptr, int known_order = 0);
 
 // The static inline helpers the Taylor functions of one precision call
 // (the recurrences of the elementary functions), once per translation unit

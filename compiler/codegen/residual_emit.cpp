@@ -28,6 +28,7 @@
 #include "codegen/emit_c.hpp"
 #include "codegen/emit_taylor.hpp"
 #include "codegen/shared_functions.hpp"
+#include "sicm/runtime.h"
 
 namespace sicm {
 
@@ -436,8 +437,14 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
 
   std::string ode(const RStmt &s, size_t dim) {
     std::string taylor = "NULL", extended = "NULL";
-    if (s.method == "sicm_ode_step_taylor") taylor = taylor_function(s.callee, false);
-    if (s.method == "sicm_ode_step_taylor_extended") extended = taylor_function(s.callee, true);
+    // The runtime integrates at tolerance s.number: the order it expands to
+    // is known here, and a small system's function gets a copy unrolled for
+    // it (emit_taylor.cpp; one shared by calls at other tolerances is
+    // unrolled for the first). Not in long double, whose x87 arithmetic
+    // gained nothing measurable (Kepler) for twice the C compiler's time.
+    int order = sicm_ode_taylor_order(s.number, s.number);
+    if (s.method == "sicm_ode_step_taylor") taylor = taylor_function(s.callee, false, order);
+    if (s.method == "sicm_ode_step_taylor_extended") extended = taylor_function(s.callee, true, 0);
     return "(sicm_drive_ode){" + s.method + ", " + closure(s.callee) + ", " + std::to_string(dim) +
            ", " + (s.time_first ? "1" : "0") + ", " + (s.rate_one ? "1" : "0") + ", " +
            c_double_literal(s.number) + ", " + closure(s.jacobian) + ", " + closure(s.probe) +
@@ -448,7 +455,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
   // The Taylor coefficient function of system derivative f (fN_taylor or
   // fN_taylor_extended), generated once; its captures are read from p[] as
   // f reads them. pe/build_mode.cpp checked that it can be generated.
-  std::string taylor_function(int f, bool extended) {
+  std::string taylor_function(int f, bool extended, int order) {
     std::string name = "f" + std::to_string(f) + (extended ? "_taylor_extended" : "_taylor");
     if (!taylor_names_.insert(name).second) return name;
     const RFunction &fn = p_.functions[f];
@@ -466,7 +473,8 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
         [&](Symbol *s) {
           auto it = captured.find(s);
           return it == captured.end() ? std::string() : it->second;
-        });
+        },
+        order);
     if (code.empty()) internal_failure(__FILE__, __LINE__, ("taylor: " + why_not).c_str());
     (extended ? taylor_extended_code_ : taylor_code_) += code + "\n";
     taylor_prototypes_ += extended ? "void " + name +

@@ -54,14 +54,17 @@
 
 #include "ode_internal.h"
 
-/* The order for tolerance eps (Jorba-Zou), within 2..SICM_ODE_TAYLOR_MAX_ORDER. */
-static int taylor_order(const sicm_ode *o) {
-  double eps = o->abs_tol;
-  if (eps == 0 || (o->rel_tol > 0 && o->rel_tol < eps)) eps = o->rel_tol;
+int sicm_ode_taylor_order(double abs_tol, double rel_tol) {
+  double eps = abs_tol;
+  if (eps == 0 || (rel_tol > 0 && rel_tol < eps)) eps = rel_tol;
   int p = (int)ceil(-log(eps) / 2) + 1;
   if (p < 2) p = 2;
   if (p > SICM_ODE_TAYLOR_MAX_ORDER) p = SICM_ODE_TAYLOR_MAX_ORDER;
   return p;
+}
+
+static int taylor_order(const sicm_ode *o) {
+  return sicm_ode_taylor_order(o->abs_tol, o->rel_tol);
 }
 
 #define REAL double

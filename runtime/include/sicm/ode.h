@@ -335,6 +335,12 @@ typedef void (*sicm_ode_taylor_coefficients)(const double *y, int order, double 
 int sicm_ode_set_taylor(sicm_ode *o, sicm_ode_taylor_coefficients coefficients,
                         const double *params);
 
+/* The order both Taylor methods expand to under the tolerances abs_tol and
+ * rel_tol (the smaller nonzero one, eps: ceil(-ln(eps) / 2) + 1, after Jorba
+ * and Zou, within 2..SICM_ODE_TAYLOR_MAX_ORDER): the order their coefficient
+ * functions are called with. */
+int sicm_ode_taylor_order(double abs_tol, double rel_tol);
+
 /* sicm_ode_set_taylor_extended gives sicm_ode_step_taylor_extended its
  * coefficient function, as sicm_ode_set_taylor but in long double (params
  * stay double: they are the program's run-time values). Returns
