@@ -110,6 +110,41 @@ TEST(TaylorEmitter, QuotientAndSquareGiveOneOverOneMinusT) {
   expect_series(series(s, {0, 1, 0}, 1), ones);
 }
 
+// Sums of squares are one recurrence (sum_sq3, and sum_sq2 in twos):
+// x' = sin^2 t + e^(2t) + (1 + t)^2, y' = cos^2 t + (2 + t)^2 + (3 + t)^2 + e^(-2t).
+TEST(TaylorEmitter, SumsOfSquares) {
+  const Kernel *k = taylor_kernel(
+      "(up 1 (+ (square (sin t)) (square (exp t)) (square (+ 1 t))) "
+      "(+ (+ (square (cos t)) (square (+ 2 t))) (+ (square (+ 3 t)) (square (exp (- t))))))");
+  ASSERT_NE(k->taylor, nullptr) << k->taylor_why_not;
+  std::vector<double> x(kOrder + 1, 0.0), y(kOrder + 1, 0.0);
+  for (int n = 0; n <= kOrder; ++n) {
+    double cos2 = n % 2 ? 0 : ((n / 2) % 2 ? -1 : 1) * std::pow(2.0, n) / factorial(n); // cos 2t
+    double sin_sq = n == 0 ? 0 : -cos2 / 2, cos_sq = (n == 0 ? 0.5 : 0) + cos2 / 2;
+    x[n] = sin_sq + std::pow(2.0, n) / factorial(n);
+    y[n] = cos_sq + std::pow(-2.0, n) / factorial(n);
+  }
+  x[0] += 1, x[1] += 2, x[2] += 1;   // (1 + t)^2
+  y[0] += 13, y[1] += 10, y[2] += 2; // (2 + t)^2 + (3 + t)^2
+  expect_series(series(k, {0, 0, 0}, 1), integral(x));
+  expect_series(series(k, {0, 0, 0}, 2), integral(y));
+}
+
+// Products sharing their later factor are computed together (product2):
+// x' = (1 + t) e^t, y' = (2 + t) e^t, so x = t e^t and y = (1 + t) e^t - 1.
+TEST(TaylorEmitter, ProductsOfOneSharedFactor) {
+  const Kernel *k =
+      taylor_kernel("(let* ((a (+ 1 t)) (b (+ 2 t)) (e (exp t))) (up 1 (* a e) (* 3 b e)))");
+  ASSERT_NE(k->taylor, nullptr) << k->taylor_why_not;
+  std::vector<double> x{0.0}, y{0.0};
+  for (int n = 1; n <= kOrder; ++n) {
+    x.push_back(1 / factorial(n - 1));
+    y.push_back(3 * (1 / factorial(n) + 1 / factorial(n - 1)));
+  }
+  expect_series(series(k, {0, 0, 0}, 1), x);
+  expect_series(series(k, {0, 0, 0}, 2), y);
+}
+
 TEST(TaylorEmitter, Sqrt) {
   const Kernel *k = taylor_kernel("(up 1 (/ 1 (* 2 (sqrt (+ 1 t)))) 0)");
   ASSERT_NE(k->taylor, nullptr) << k->taylor_why_not;
