@@ -1,7 +1,10 @@
 // What each kernel of a built program computes (see kernel_report.hpp).
 #include "codegen/kernel_report.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <regex>
 #include <set>
 #include <unordered_map>
 
@@ -22,6 +25,7 @@ const std::set<std::string> kNotCalls = {"if",
                                          "switch",
                                          "return",
                                          "sizeof",
+                                         "_Pragma",
                                          "sicm_ldlt_factor",
                                          "sicm_lu_factor",
                                          "sicm_singular_nan"};
@@ -50,14 +54,70 @@ std::string code_only(std::string_view s) {
   return out;
 }
 
-} // namespace
-
-std::map<std::string, size_t> count_c_ops(std::string_view body) {
-  std::map<std::string, size_t> ops;
-  for (const char *op : kReportedOps)
-    ops[op] = 0;
-  const std::string code = code_only(body);
+// Where the statement that begins at code[i] (after blanks) ends: a block
+// at its closing brace, a for loop after its body, anything else after its
+// semicolon.
+size_t statement_end(const std::string &code, size_t i) {
   const size_t n = code.size();
+  while (i < n && std::isspace(static_cast<unsigned char>(code[i])))
+    ++i;
+  if (i < n && code[i] == '{') {
+    int depth = 0;
+    for (; i < n; ++i) {
+      depth += code[i] == '{' ? 1 : code[i] == '}' ? -1 : 0;
+      if (depth == 0) return i + 1;
+    }
+    return n;
+  }
+  if (code.compare(i, 3, "for") == 0) {
+    size_t open = code.find('(', i);
+    int depth = 0;
+    for (size_t k = open; k < n; ++k) {
+      depth += code[k] == '(' ? 1 : code[k] == ')' ? -1 : 0;
+      if (depth == 0) return statement_end(code, k + 1);
+    }
+    return n;
+  }
+  int depth = 0;
+  for (; i < n; ++i) {
+    depth += code[i] == '(' || code[i] == '[' ? 1 : code[i] == ')' || code[i] == ']' ? -1 : 0;
+    if (code[i] == ';' && depth == 0) return i + 1;
+  }
+  return n;
+}
+
+// The loop variables of the loops around a body: their ranges [lo, hi).
+using LoopRanges = std::map<std::string, std::pair<double, double>>;
+
+// How many times a loop with this header (the text between its parentheses)
+// runs, on average over the enclosing loops: the emitter's forms `int v = A;
+// v < B; ++v` with numbers A and B, and `int v = w + c; v < B; ++v` over an
+// enclosing loop's variable w (the pairs i < j); any other loop counts once.
+double trip_count(const std::string &header, LoopRanges &ranges, std::string *var) {
+  static const std::regex form(
+      R"(\s*int (\w+) = (\w+)(?: \+ (\d+))?; (\w+) < (\d+); \+\+(\w+)\s*)");
+  std::smatch m;
+  if (!std::regex_match(header, m, form) || m[1] != m[4] || m[1] != m[6]) return 1;
+  *var = m[1];
+  double hi = std::stod(m[5]), offset = m[3].matched ? std::stod(m[3]) : 0, lo;
+  if (std::isdigit(static_cast<unsigned char>(m[2].str()[0]))) {
+    lo = std::stod(m[2]) + offset;
+    ranges[*var] = {lo, hi};
+    return std::max(0.0, hi - lo);
+  }
+  auto outer = ranges.find(m[2]);
+  if (outer == ranges.end()) return 1;
+  // v runs from w + c: on average from the mean of w's range plus c.
+  double mean = (outer->second.first + outer->second.second - 1) / 2;
+  lo = mean + offset;
+  ranges[*var] = {lo, hi};
+  return std::max(0.0, hi - lo);
+}
+
+void count_ops(const std::string &code, double times, LoopRanges ranges,
+               std::map<std::string, double> &ops) {
+  const size_t n = code.size();
+  int brackets = 0; // inside an index: its arithmetic is addressing, not the kernel's
   for (size_t i = 0; i < n;) {
     char c = code[i];
     if (std::isdigit(static_cast<unsigned char>(c)) ||
@@ -77,6 +137,21 @@ std::map<std::string, size_t> count_c_ops(std::string_view body) {
       size_t k = i;
       while (k < n && code[k] == ' ')
         ++k;
+      if (word == "for" && k < n && code[k] == '(') {
+        // A loop: its body's operations as many times as it runs.
+        size_t close = k;
+        for (int depth = 0; close < n; ++close) {
+          depth += code[close] == '(' ? 1 : code[close] == ')' ? -1 : 0;
+          if (depth == 0) break;
+        }
+        std::string var;
+        LoopRanges inner = ranges;
+        double trips = trip_count(code.substr(k + 1, close - k - 1), inner, &var);
+        size_t end = statement_end(code, close + 1);
+        count_ops(code.substr(close + 1, end - close - 1), times * trips, inner, ops);
+        i = end;
+        continue;
+      }
       if (k >= n || code[k] != '(' || kNotCalls.count(word)) continue;
       // The checked forms of the program's own arithmetic (sicm/program.h)
       // are the operation they check.
@@ -84,16 +159,16 @@ std::map<std::string, size_t> count_c_ops(std::string_view body) {
       if (word == "sicm_checked_log") word = "log";
       if (word == "sicm_checked_pow") word = "pow";
       if (word == "sincos") {
-        ++ops["sin"], ++ops["cos"];
+        ops["sin"] += times, ops["cos"] += times;
       } else if (word == "sicm_checked_quotient") {
-        ++ops["div"];
+        ops["div"] += times;
       } else if (word == "sqrt" || word == "sin" || word == "cos" || word == "exp" ||
                  word == "log" || word == "pow" || word == "atan2") {
-        ++ops[word];
+        ops[word] += times;
       } else if (word == "sicm_ldlt_solve" || word == "sicm_lu_solve") {
-        ++ops["solve"];
+        ops["solve"] += times;
       } else {
-        ++ops["call"];
+        ops["call"] += times;
       }
       continue;
     }
@@ -102,11 +177,24 @@ std::map<std::string, size_t> count_c_ops(std::string_view body) {
       i += 2; // ++, --, +=, -=, ->: loop bookkeeping in the solve helpers, not arithmetic
       continue;
     }
-    if (c == '+' || c == '-') ++ops["add"];
-    if (c == '*' && next != '=') ++ops["mul"];
-    if (c == '/' && next != '=') ++ops["div"];
+    brackets += c == '[' ? 1 : c == ']' ? -1 : 0;
+    if (brackets == 0) {
+      if (c == '+' || c == '-') ops["add"] += times;
+      if (c == '*' && next != '=') ops["mul"] += times;
+      if (c == '/' && next != '=') ops["div"] += times;
+    }
     ++i;
   }
+}
+
+} // namespace
+
+std::map<std::string, size_t> count_c_ops(std::string_view body) {
+  std::map<std::string, double> counted;
+  count_ops(code_only(body), 1, {}, counted);
+  std::map<std::string, size_t> ops;
+  for (const char *op : kReportedOps)
+    ops[op] = static_cast<size_t>(std::llround(counted[op]));
   return ops;
 }
 

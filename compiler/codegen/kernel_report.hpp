@@ -35,7 +35,11 @@ struct KernelReport {
   size_t total = 0;
 };
 
-// The operations of a C function body (the text between its braces).
+// The operations of a C function body (the text between its braces). The
+// body of a loop the emitter writes over instances or pairs
+// (codegen/loops.hpp: `for (int v = A; v < B; ++v)`, `v = w + 1` over the
+// pairs) counts as many times as it runs; other loops once. Arithmetic
+// inside an index is addressing, not counted.
 std::map<std::string, size_t> count_c_ops(std::string_view body);
 
 // The kernels of a residual program, with the C emitted for it.

@@ -156,3 +156,23 @@ TEST(ReportOps, CheckedOperationsCountAsTheOperation) {
   EXPECT_EQ(ops["add"], 4u);
   EXPECT_EQ(ops["mul"], 1u);
 }
+
+// A loop's body counts as many times as the loop runs: the pairs i < j of
+// n bodies n (n - 1) / 2 times; its index arithmetic is not the kernel's.
+TEST(ReportOps, LoopBodiesCountOncePerIteration) {
+  auto ops = sicm::count_c_ops("  for (int oo0 = 0; oo0 < 300; ++oo0)\n"
+                               "    out[301 + oo0] = -0.0;\n"
+                               "  for (int oi0 = 0; oi0 < 100; ++oi0)\n"
+                               "    for (int oj0 = oi0 + 1; oj0 < 100; ++oj0) {\n"
+                               "    double d = in[1 + 3 * oi0] - in[1 + 3 * oj0];\n"
+                               "    double r = sqrt(d * d);\n"
+                               "    out[2 + oi0] = out[2 + oi0] + d / r;\n"
+                               "  }\n"
+                               "  out[0] = in[0] * 2.0;\n"
+                               "  for (int k = 0; k < order; ++k) out[k] = out[k] + 1.0;\n");
+  EXPECT_EQ(ops["sqrt"], 4950u);
+  EXPECT_EQ(ops["add"], 300u + 2 * 4950u + 1u); // -0.0, d's -, the sum's +, the last loop once
+  EXPECT_EQ(ops["mul"], 4950u + 1u);
+  EXPECT_EQ(ops["div"], 4950u);
+  EXPECT_EQ(ops["call"], 0u);
+}
