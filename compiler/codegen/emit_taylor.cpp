@@ -53,6 +53,7 @@
 #include "base/error.hpp"
 #include "base/number.hpp"
 #include "codegen/emit_c.hpp"
+#include "codegen/taylor_loops.hpp"
 #include "sicm/runtime.h"
 
 namespace sicm {
@@ -186,7 +187,7 @@ private:
     return "(k == 0 ? " + scalar(id) + " : 0)";
   }
 
-  void line(const std::string &s) { body_ += "    " + s + "\n"; }
+  void line(const std::string &s) { statements_.push_back(s); }
 
   // Emit the statements computing coefficient k of series node id.
   bool emit_node(ExprId id, std::string *why_not) {
@@ -452,12 +453,42 @@ private:
         f += emit_c_assignments(constants_, constant_names_, spell_symbol(), "u", "");
       }
     }
+    TaylorLoops loops;
+    if (tables_.empty()) { // (a solve's tables name its arrays)
+      std::vector<std::string> spreads;
+      for (const auto &[id, name] : spread_)
+        spreads.push_back(name);
+      loops = plan_taylor_loops(statements_, arrays_, spreads, "cf");
+    }
+    if (!loops.empty()) return "#include <stdlib.h>\n" + f + pooled(loops, outs);
     for (const std::string &a : arrays_)
       f += "  " + real_ + " " + a + "[K];\n";
     f += tables_;
     f += spread_inits_;
     f += "  for (int i = 0; i < " + std::to_string(n) + "; ++i) c[i] = in[i];\n";
-    f += "  for (int k = 0; k < order; ++k) {\n" + body_ + outs + "  }\n}\n";
+    std::string body;
+    for (const std::string &s : statements_)
+      body += "    " + s + "\n";
+    f += "  for (int k = 0; k < order; ++k) {\n" + body + outs + "  }\n}\n";
+    return f;
+  }
+
+  // The rest of the function when its statements are loops over the rows of one pool of
+  // coefficients (codegen/taylor_loops.hpp), outs its output statements: the pool, on the
+  // heap (it may be larger than a stack), allocated once per thread and kept; when it cannot
+  // be, every coefficient past the state is NaN, which fails the step.
+  std::string pooled(const TaylorLoops &loops, const std::string &outs) {
+    const std::string n = std::to_string(t_.inputs.size());
+    std::string f = loops.tables;
+    f += "  static _Thread_local " + real_ + " (*cf)[K];\n";
+    f += "  if (!cf) cf = malloc(sizeof(" + real_ + "[K]) * " + std::to_string(loops.rows) + ");\n";
+    f += "  if (!cf) {\n";
+    f += "    for (int i = 0; i < (order + 1) * " + n + "; ++i) c[i] = i < " + n +
+         " ? in[i] : NAN;\n";
+    f += "    return;\n  }\n";
+    f += loops.in_pool(spread_inits_);
+    f += "  for (int i = 0; i < " + n + "; ++i) c[i] = in[i];\n";
+    f += "  for (int k = 0; k < order; ++k) {\n" + loops.body + loops.in_pool(outs) + "  }\n}\n";
     return f;
   }
 
@@ -518,7 +549,8 @@ private:
   std::unordered_map<ExprId, std::string> array_of_, scalar_, spread_;
   std::vector<ExprId> constants_;
   std::vector<std::string> constant_names_, arrays_;
-  std::string body_, spread_inits_, tables_;
+  std::vector<std::string> statements_; // order k's, one C statement each
+  std::string spread_inits_, tables_;
   size_t narrays_ = 0, nsolves_ = 0;
 };
 

@@ -1,0 +1,249 @@
+// Repeated recurrences of a Taylor function found as loops (see taylor_loops.hpp).
+//
+// Approach, after heyoka's compact mode. The Taylor emitter writes order k as one statement
+// per recurrence (a product, a power, a sum, ...), over its nodes in id order, and an N-body
+// derivative gives the same few recurrences once per pair of bodies and sums of them once per
+// body. Ids interleave those instances (a pair's terms, then partial sums of the forces of
+// earlier pairs; a node shared by pairs computed in the first that needs it), so runs of
+// instances are not found in that order as codegen/loops.cpp finds them in a kernel's
+// schedule. Instead each statement gets a depth, one more than that of the deepest statement
+// whose array it reads (0 when it reads none), and statements of one depth with the same text
+// once their arrays are abstracted to slots (numbered by first appearance, so which arrays
+// coincide is part of the text) form a group. The statements of one depth read only arrays
+// of smaller depths, so running the depths in order, the groups of a depth in any order,
+// computes every coefficient from the same values as the unrolled order did: each statement
+// is the same C (the same recurrence, the same scalars, the same order of its operations),
+// so the coefficients are bit for bit the unrolled ones.
+//
+// Every array becomes a row of one pool; rows are numbered in the order the statements
+// write them, so a group writes consecutive rows and many of the rows it reads are affine in
+// the member too (one pair's arrays after another's). A group of at least kMinGroup members
+// is a loop over its members, each slot's rows affine in the member number or read from a
+// static table of ints; a smaller one stays straight-line. The pool lives on the heap, one
+// per thread, allocated once: its size (rows x K coefficients) passes the stack's at about
+// 60 bodies.
+//
+// Limits: loops only when a group has at least kMinLoopInstances members, so that small
+// systems (Kepler, 10 bodies) keep the straight-line C the C compiler schedules best and
+// their C is what it was.
+#include "codegen/taylor_loops.hpp"
+
+#include <algorithm>
+#include <map>
+
+namespace sicm {
+
+namespace {
+
+constexpr size_t kMinLoopInstances = 256;
+constexpr size_t kMinGroup = 4;
+
+bool is_identifier_start(char ch) {
+  return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || ch == '_';
+}
+
+bool is_identifier_char(char ch) {
+  return is_identifier_start(ch) || (ch >= '0' && ch <= '9');
+}
+
+// An array's name in a statement: text [begin, end) names array `array`.
+struct ArrayToken {
+  size_t begin, end;
+  size_t array;
+};
+
+// The arrays a text names, in order; numbers are skipped whole, so the e5 of 1e5 is no name.
+std::vector<ArrayToken> array_tokens(const std::string &text,
+                                     const std::unordered_map<std::string, size_t> &ids) {
+  std::vector<ArrayToken> tokens;
+  for (size_t i = 0; i < text.size();) {
+    size_t j = i + 1;
+    if (is_identifier_start(text[i])) {
+      while (j < text.size() && is_identifier_char(text[j]))
+        ++j;
+      auto it = ids.find(text.substr(i, j - i));
+      if (it != ids.end()) tokens.push_back({i, j, it->second});
+    } else if (text[i] >= '0' && text[i] <= '9') {
+      while (j < text.size() && (is_identifier_char(text[j]) || text[j] == '.'))
+        ++j;
+    }
+    i = j;
+  }
+  return tokens;
+}
+
+// A statement with its arrays abstracted: the text with "$s" for slot s, and slot s's array.
+struct Shape {
+  std::string text;
+  std::vector<size_t> slots;
+};
+
+Shape shape_of(const std::string &statement, const std::unordered_map<std::string, size_t> &ids) {
+  Shape shape;
+  size_t at = 0;
+  for (const ArrayToken &token : array_tokens(statement, ids)) {
+    auto it = std::find(shape.slots.begin(), shape.slots.end(), token.array);
+    size_t slot = size_t(it - shape.slots.begin());
+    if (it == shape.slots.end()) shape.slots.push_back(token.array);
+    shape.text += statement.substr(at, token.begin - at) + "$" + std::to_string(slot) + "$";
+    at = token.end;
+  }
+  shape.text += statement.substr(at);
+  return shape;
+}
+
+// shape's text with slot s written as slot_text[s].
+std::string instantiate(const std::string &text, const std::vector<std::string> &slot_text) {
+  std::string out;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '$') {
+      out += text[i];
+      continue;
+    }
+    size_t close = text.find('$', i + 1);
+    out += slot_text[std::stoul(text.substr(i + 1, close - i - 1))];
+    i = close;
+  }
+  return out;
+}
+
+// Statements of one depth and shape, in the emitter's order.
+struct Group {
+  size_t depth;
+  std::vector<size_t> members;
+};
+
+} // namespace
+
+std::string TaylorLoops::in_pool(const std::string &text) const {
+  std::unordered_map<std::string, size_t> ids;
+  std::vector<size_t> rows;
+  for (const auto &[name, row] : row_of) {
+    ids.emplace(name, rows.size());
+    rows.push_back(row);
+  }
+  std::string out;
+  size_t at = 0;
+  for (const ArrayToken &token : array_tokens(text, ids)) {
+    out += text.substr(at, token.begin - at) + pool + "[" + std::to_string(rows[token.array]) + "]";
+    at = token.end;
+  }
+  return out + text.substr(at);
+}
+
+TaylorLoops plan_taylor_loops(const std::vector<std::string> &statements,
+                              const std::vector<std::string> &arrays,
+                              const std::vector<std::string> &before_loop,
+                              const std::string &pool) {
+  std::unordered_map<std::string, size_t> ids;
+  for (size_t a = 0; a < arrays.size(); ++a)
+    ids.emplace(arrays[a], a);
+  const size_t kNone = size_t(-1);
+  // writer[a]: the statement that writes array a, the first that names it.
+  std::vector<size_t> writer(arrays.size(), kNone);
+  std::vector<bool> filled_before(arrays.size(), false);
+  for (const std::string &name : before_loop)
+    filled_before[ids.at(name)] = true;
+  std::vector<Shape> shapes;
+  std::vector<size_t> depth(statements.size(), 0);
+  std::vector<Group> groups;
+  std::map<std::pair<size_t, std::string>, size_t> group_of;
+  size_t largest = 0;
+  for (size_t i = 0; i < statements.size(); ++i) {
+    shapes.push_back(shape_of(statements[i], ids));
+    for (size_t a : shapes[i].slots) {
+      if (filled_before[a]) continue;
+      if (writer[a] == kNone)
+        writer[a] = i;
+      else
+        depth[i] = std::max(depth[i], depth[writer[a]] + 1);
+    }
+    auto [it, fresh] = group_of.emplace(std::pair(depth[i], shapes[i].text), groups.size());
+    if (fresh) groups.push_back({depth[i], {}});
+    groups[it->second].members.push_back(i);
+    largest = std::max(largest, groups[it->second].members.size());
+  }
+  TaylorLoops plan;
+  if (largest < kMinLoopInstances) return plan;
+  plan.pool = pool;
+
+  // The depths in order, a depth's groups in the order of their first statements.
+  std::vector<size_t> order(groups.size());
+  for (size_t g = 0; g < groups.size(); ++g)
+    order[g] = g;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return groups[a].depth < groups[b].depth; });
+
+  // Rows: the arrays filled before the loop, then the others as the statements write them.
+  std::vector<size_t> row(arrays.size(), kNone);
+  size_t rows = 0;
+  for (size_t a = 0; a < arrays.size(); ++a)
+    if (filled_before[a]) row[a] = rows++;
+  for (size_t g : order)
+    for (size_t i : groups[g].members)
+      for (size_t a : shapes[i].slots)
+        if (writer[a] == i) row[a] = rows++;
+  for (size_t a = 0; a < arrays.size(); ++a)
+    if (row[a] == kNone) row[a] = rows++; // named by no statement
+  plan.rows = rows;
+  for (size_t a = 0; a < arrays.size(); ++a)
+    plan.row_of[arrays[a]] = row[a];
+
+  const std::string table = pool + "_rows";
+  std::vector<long> entries;
+  auto at_row = [&](const std::string &index) { return pool + "[" + index + "]"; };
+  for (size_t g : order) {
+    const std::vector<size_t> &members = groups[g].members;
+    const Shape &first = shapes[members[0]];
+    const size_t nslots = first.slots.size();
+    if (members.size() < kMinGroup) {
+      for (size_t i : members) {
+        std::vector<std::string> slot_text;
+        for (size_t a : shapes[i].slots)
+          slot_text.push_back(at_row(std::to_string(row[a])));
+        plan.body += "    " + instantiate(first.text, slot_text) + "\n";
+      }
+      continue;
+    }
+    // Slot s in member m: row base + stride * m, or the table's next column.
+    std::vector<std::string> slot_text(nslots);
+    std::vector<size_t> tabled;
+    for (size_t s = 0; s < nslots; ++s) {
+      auto row_at = [&](size_t m) { return long(row[shapes[members[m]].slots[s]]); };
+      const long base = row_at(0), stride = row_at(1) - base;
+      bool affine = true;
+      for (size_t m = 2; m < members.size() && affine; ++m)
+        affine = row_at(m) == base + stride * long(m);
+      if (!affine) {
+        slot_text[s] = at_row("row[" + std::to_string(tabled.size()) + "]");
+        tabled.push_back(s);
+      } else if (stride == 0) {
+        slot_text[s] = at_row(std::to_string(base));
+      } else {
+        std::string step =
+            stride == 1 ? "i" : std::to_string(stride < 0 ? -stride : stride) + " * i";
+        slot_text[s] = at_row(std::to_string(base) + (stride < 0 ? " - " : " + ") + step);
+      }
+    }
+    plan.body += "    for (int i = 0; i < " + std::to_string(members.size()) + "; ++i) {\n";
+    if (!tabled.empty()) {
+      plan.body += "      const int *row = " + table + " + " + std::to_string(entries.size());
+      plan.body +=
+          tabled.size() == 1 ? " + i;\n" : " + " + std::to_string(tabled.size()) + " * i;\n";
+      for (size_t i : members)
+        for (size_t s : tabled)
+          entries.push_back(long(row[shapes[i].slots[s]]));
+    }
+    plan.body += "      " + instantiate(first.text, slot_text) + "\n    }\n";
+  }
+  if (!entries.empty()) {
+    plan.tables = "  static const int " + table + "[" + std::to_string(entries.size()) + "] = {";
+    for (size_t e = 0; e < entries.size(); ++e)
+      plan.tables += (e % 16 == 0 ? "\n     " : "") + std::string(" ") +
+                     std::to_string(entries[e]) + (e + 1 < entries.size() ? "," : "");
+    plan.tables += "\n  };\n";
+  }
+  return plan;
+}
+
+} // namespace sicm
