@@ -433,10 +433,12 @@ private:
     // c_{k+1} = f_k / (k + 1): one division for the whole order, each
     // component a multiplication by its reciprocal (a division costs as
     // much as a dozen multiplications, and there is one per component).
-    std::string outs = "    const " + real_ + " reciprocal = (" + real_ + ")1 / (k + 1);\n";
+    const std::string reciprocal =
+        "    const " + real_ + " reciprocal = (" + real_ + ")1 / (k + 1);\n";
+    std::vector<std::string> outs;
     for (size_t i = 0; i < n; ++i)
-      outs += "    c[(k + 1) * " + std::to_string(n) + " + " + std::to_string(i) +
-              "] = " + coefficient_k(t_.outputs[i]) + " * reciprocal;\n";
+      outs.push_back("c[(k + 1) * " + std::to_string(n) + " + " + std::to_string(i) +
+                     "] = " + coefficient_k(t_.outputs[i]) + " * reciprocal;");
     std::string f = "void " + c_name + "(const " + real_ + " *in, int order, " + real_ +
                     " *c, const double *p) {\n";
     f += "  (void)p;\n";
@@ -458,9 +460,11 @@ private:
       std::vector<std::string> spreads;
       for (const auto &[id, name] : spread_)
         spreads.push_back(name);
-      loops = plan_taylor_loops(statements_, arrays_, spreads, "cf");
+      std::vector<std::string> statements = statements_;
+      statements.insert(statements.end(), outs.begin(), outs.end());
+      loops = plan_taylor_loops(statements, arrays_, spreads, "cf");
     }
-    if (!loops.empty()) return "#include <stdlib.h>\n" + f + pooled(loops, outs);
+    if (!loops.empty()) return "#include <stdlib.h>\n" + f + pooled(loops, reciprocal);
     for (const std::string &a : arrays_)
       f += "  " + real_ + " " + a + "[K];\n";
     f += tables_;
@@ -469,15 +473,19 @@ private:
     std::string body;
     for (const std::string &s : statements_)
       body += "    " + s + "\n";
-    f += "  for (int k = 0; k < order; ++k) {\n" + body + outs + "  }\n}\n";
+    body += reciprocal;
+    for (const std::string &s : outs)
+      body += "    " + s + "\n";
+    f += "  for (int k = 0; k < order; ++k) {\n" + body + "  }\n}\n";
     return f;
   }
 
   // The rest of the function when its statements are loops over the rows of one pool of
-  // coefficients (codegen/taylor_loops.hpp), outs its output statements: the pool, on the
+  // coefficients (codegen/taylor_loops.hpp), the outputs' among them (after reciprocal, the
+  // declaration they read, now first in the order): the pool, on the
   // heap (it may be larger than a stack), allocated once per thread and kept; when it cannot
   // be, every coefficient past the state is NaN, which fails the step.
-  std::string pooled(const TaylorLoops &loops, const std::string &outs) {
+  std::string pooled(const TaylorLoops &loops, const std::string &reciprocal) {
     const std::string n = std::to_string(t_.inputs.size());
     std::string f = loops.tables;
     f += "  static _Thread_local " + real_ + " (*cf)[K];\n";
@@ -488,7 +496,7 @@ private:
     f += "    return;\n  }\n";
     f += loops.in_pool(spread_inits_);
     f += "  for (int i = 0; i < " + n + "; ++i) c[i] = in[i];\n";
-    f += "  for (int k = 0; k < order; ++k) {\n" + loops.body + loops.in_pool(outs) + "  }\n}\n";
+    f += "  for (int k = 0; k < order; ++k) {\n" + reciprocal + loops.body + "  }\n}\n";
     return f;
   }
 

@@ -46,46 +46,60 @@ bool is_identifier_char(char ch) {
   return is_identifier_start(ch) || (ch >= '0' && ch <= '9');
 }
 
-// An array's name in a statement: text [begin, end) names array `array`.
-struct ArrayToken {
+// A token of a statement that differs between instances: text [begin, end) names array
+// `value`, or is the integer `value` as an index (97 in c[k * 193 + 97], the state's
+// component a statement loads).
+struct Token {
   size_t begin, end;
-  size_t array;
+  bool is_array;
+  long value;
 };
 
-// The arrays a text names, in order; numbers are skipped whole, so the e5 of 1e5 is no name.
-std::vector<ArrayToken> array_tokens(const std::string &text,
-                                     const std::unordered_map<std::string, size_t> &ids) {
-  std::vector<ArrayToken> tokens;
+// The arrays a text names (and, with indices, the integers it indexes with), in order;
+// numbers are read whole, so the e5 of 1e5 is no name.
+std::vector<Token> tokens_of(const std::string &text,
+                             const std::unordered_map<std::string, size_t> &ids, bool indices) {
+  std::vector<Token> tokens;
   for (size_t i = 0; i < text.size();) {
     size_t j = i + 1;
     if (is_identifier_start(text[i])) {
       while (j < text.size() && is_identifier_char(text[j]))
         ++j;
       auto it = ids.find(text.substr(i, j - i));
-      if (it != ids.end()) tokens.push_back({i, j, it->second});
+      if (it != ids.end()) tokens.push_back({i, j, true, long(it->second)});
     } else if (text[i] >= '0' && text[i] <= '9') {
-      while (j < text.size() && (is_identifier_char(text[j]) || text[j] == '.'))
+      bool integer = true;
+      while (j < text.size() && (is_identifier_char(text[j]) || text[j] == '.')) {
+        integer = integer && text[j] >= '0' && text[j] <= '9';
         ++j;
+      }
+      if (indices && integer && j < text.size() && text[j] == ']' && j - i < 10)
+        tokens.push_back({i, j, false, std::stol(text.substr(i, j - i))});
     }
     i = j;
   }
   return tokens;
 }
 
-// A statement with its arrays abstracted: the text with "$s" for slot s, and slot s's array.
+// A statement with what differs abstracted: the text with "$s$" for slot s, an array
+// (numbered by first appearance, so which arrays coincide is part of the text), and "#s#"
+// for slot s, an index.
 struct Shape {
   std::string text;
-  std::vector<size_t> slots;
+  std::vector<Token> slots; // their values; begin and end unused
 };
 
 Shape shape_of(const std::string &statement, const std::unordered_map<std::string, size_t> &ids) {
   Shape shape;
   size_t at = 0;
-  for (const ArrayToken &token : array_tokens(statement, ids)) {
-    auto it = std::find(shape.slots.begin(), shape.slots.end(), token.array);
-    size_t slot = size_t(it - shape.slots.begin());
-    if (it == shape.slots.end()) shape.slots.push_back(token.array);
-    shape.text += statement.substr(at, token.begin - at) + "$" + std::to_string(slot) + "$";
+  for (const Token &token : tokens_of(statement, ids, true)) {
+    size_t slot = 0;
+    while (slot < shape.slots.size() && !(token.is_array && shape.slots[slot].is_array &&
+                                          shape.slots[slot].value == token.value))
+      ++slot;
+    if (slot == shape.slots.size()) shape.slots.push_back(token);
+    const char *mark = token.is_array ? "$" : "#";
+    shape.text += statement.substr(at, token.begin - at) + mark + std::to_string(slot) + mark;
     at = token.end;
   }
   shape.text += statement.substr(at);
@@ -96,11 +110,11 @@ Shape shape_of(const std::string &statement, const std::unordered_map<std::strin
 std::string instantiate(const std::string &text, const std::vector<std::string> &slot_text) {
   std::string out;
   for (size_t i = 0; i < text.size(); ++i) {
-    if (text[i] != '$') {
+    if (text[i] != '$' && text[i] != '#') {
       out += text[i];
       continue;
     }
-    size_t close = text.find('$', i + 1);
+    size_t close = text.find(text[i], i + 1);
     out += slot_text[std::stoul(text.substr(i + 1, close - i - 1))];
     i = close;
   }
@@ -124,8 +138,9 @@ std::string TaylorLoops::in_pool(const std::string &text) const {
   }
   std::string out;
   size_t at = 0;
-  for (const ArrayToken &token : array_tokens(text, ids)) {
-    out += text.substr(at, token.begin - at) + pool + "[" + std::to_string(rows[token.array]) + "]";
+  for (const Token &token : tokens_of(text, ids, false)) {
+    out += text.substr(at, token.begin - at) + pool + "[" +
+           std::to_string(rows[size_t(token.value)]) + "]";
     at = token.end;
   }
   return out + text.substr(at);
@@ -151,8 +166,9 @@ TaylorLoops plan_taylor_loops(const std::vector<std::string> &statements,
   size_t largest = 0;
   for (size_t i = 0; i < statements.size(); ++i) {
     shapes.push_back(shape_of(statements[i], ids));
-    for (size_t a : shapes[i].slots) {
-      if (filled_before[a]) continue;
+    for (const Token &slot : shapes[i].slots) {
+      const size_t a = size_t(slot.value);
+      if (!slot.is_array || filled_before[a]) continue;
       if (writer[a] == kNone)
         writer[a] = i;
       else
@@ -181,8 +197,8 @@ TaylorLoops plan_taylor_loops(const std::vector<std::string> &statements,
     if (filled_before[a]) row[a] = rows++;
   for (size_t g : order)
     for (size_t i : groups[g].members)
-      for (size_t a : shapes[i].slots)
-        if (writer[a] == i) row[a] = rows++;
+      for (const Token &slot : shapes[i].slots)
+        if (slot.is_array && writer[size_t(slot.value)] == i) row[size_t(slot.value)] = rows++;
   for (size_t a = 0; a < arrays.size(); ++a)
     if (row[a] == kNone) row[a] = rows++; // named by no statement
   plan.rows = rows;
@@ -191,7 +207,14 @@ TaylorLoops plan_taylor_loops(const std::vector<std::string> &statements,
 
   const std::string table = pool + "_rows";
   std::vector<long> entries;
-  auto at_row = [&](const std::string &index) { return pool + "[" + index + "]"; };
+  // Slot s of the members as C: an array's row in the pool, an index as it is; value_at(m):
+  // its row or index in member m.
+  auto slot_c = [&](const Token &slot, const std::string &index) {
+    return slot.is_array ? pool + "[" + index + "]" : index;
+  };
+  auto value_at = [&](const Token &slot) {
+    return slot.is_array ? long(row[size_t(slot.value)]) : slot.value;
+  };
   for (size_t g : order) {
     const std::vector<size_t> &members = groups[g].members;
     const Shape &first = shapes[members[0]];
@@ -199,30 +222,32 @@ TaylorLoops plan_taylor_loops(const std::vector<std::string> &statements,
     if (members.size() < kMinGroup) {
       for (size_t i : members) {
         std::vector<std::string> slot_text;
-        for (size_t a : shapes[i].slots)
-          slot_text.push_back(at_row(std::to_string(row[a])));
+        for (const Token &slot : shapes[i].slots)
+          slot_text.push_back(slot_c(slot, std::to_string(value_at(slot))));
         plan.body += "    " + instantiate(first.text, slot_text) + "\n";
       }
       continue;
     }
-    // Slot s in member m: row base + stride * m, or the table's next column.
+    // Slot s in member m: base + stride * m, or the table's next column.
     std::vector<std::string> slot_text(nslots);
     std::vector<size_t> tabled;
     for (size_t s = 0; s < nslots; ++s) {
-      auto row_at = [&](size_t m) { return long(row[shapes[members[m]].slots[s]]); };
+      auto row_at = [&](size_t m) { return value_at(shapes[members[m]].slots[s]); };
+      const Token &slot = first.slots[s];
       const long base = row_at(0), stride = row_at(1) - base;
       bool affine = true;
       for (size_t m = 2; m < members.size() && affine; ++m)
         affine = row_at(m) == base + stride * long(m);
       if (!affine) {
-        slot_text[s] = at_row("row[" + std::to_string(tabled.size()) + "]");
+        slot_text[s] = slot_c(slot, "row[" + std::to_string(tabled.size()) + "]");
         tabled.push_back(s);
       } else if (stride == 0) {
-        slot_text[s] = at_row(std::to_string(base));
+        slot_text[s] = slot_c(slot, std::to_string(base));
       } else {
         std::string step =
             stride == 1 ? "i" : std::to_string(stride < 0 ? -stride : stride) + " * i";
-        slot_text[s] = at_row(std::to_string(base) + (stride < 0 ? " - " : " + ") + step);
+        std::string index = std::to_string(base) + (stride < 0 ? " - " : " + ") + step;
+        slot_text[s] = slot_c(slot, slot.is_array ? index : "(" + index + ")");
       }
     }
     plan.body += "    for (int i = 0; i < " + std::to_string(members.size()) + "; ++i) {\n";
@@ -232,7 +257,7 @@ TaylorLoops plan_taylor_loops(const std::vector<std::string> &statements,
           tabled.size() == 1 ? " + i;\n" : " + " + std::to_string(tabled.size()) + " * i;\n";
       for (size_t i : members)
         for (size_t s : tabled)
-          entries.push_back(long(row[shapes[i].slots[s]]));
+          entries.push_back(value_at(shapes[i].slots[s]));
     }
     plan.body += "      " + instantiate(first.text, slot_text) + "\n    }\n";
   }
