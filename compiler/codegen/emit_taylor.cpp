@@ -462,7 +462,7 @@ private:
         spreads.push_back(name);
       std::vector<std::string> statements = statements_;
       statements.insert(statements.end(), outs.begin(), outs.end());
-      loops = plan_taylor_loops(statements, arrays_, spreads, "cf");
+      loops = plan_taylor_loops(statements, arrays_, spreads, constant_names_, "cf", "kc");
     }
     if (!loops.empty()) return "#include <stdlib.h>\n" + f + pooled(loops, reciprocal);
     for (const std::string &a : arrays_)
@@ -488,6 +488,12 @@ private:
   std::string pooled(const TaylorLoops &loops, const std::string &reciprocal) {
     const std::string n = std::to_string(t_.inputs.size());
     std::string f = loops.tables;
+    if (loops.scalar_array) {
+      f += "  const " + real_ + " kc[] = {";
+      for (size_t i = 0; i < constant_names_.size(); ++i)
+        f += (i ? ", " : "") + constant_names_[i];
+      f += "};\n";
+    }
     f += "  static _Thread_local " + real_ + " (*cf)[K];\n";
     f += "  if (!cf) cf = malloc(sizeof(" + real_ + "[K]) * " + std::to_string(loops.rows) + ");\n";
     f += "  if (!cf) {\n";

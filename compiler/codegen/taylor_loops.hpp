@@ -24,6 +24,7 @@ struct TaylorLoops {
   std::string tables; // the static index tables the loops read, as declarations
   std::unordered_map<std::string, size_t> row_of; // array -> its row
   std::string pool;                               // the pool's C name
+  bool scalar_array = false; // whether the body reads scalars as elements of an array of them
 
   bool empty() const { return rows == 0; }
   // text with each array name written as its pool row ("pool[12]").
@@ -32,9 +33,14 @@ struct TaylorLoops {
 
 // The loops of statements when one recurrence repeats at least kMinLoopInstances times at one
 // depth (see taylor_loops.cpp); else an empty plan. before_loop: the arrays that are filled
-// before the k loop (constants spread into arrays), which no statement writes.
+// before the k loop (constants spread into arrays), which no statement writes. scalars: the
+// names of the constants the statements read; a loop whose members read different ones reads
+// them from scalar_array, {scalars[0], scalars[1], ...}, which the caller declares when the
+// plan says so.
 TaylorLoops plan_taylor_loops(const std::vector<std::string> &statements,
                               const std::vector<std::string> &arrays,
-                              const std::vector<std::string> &before_loop, const std::string &pool);
+                              const std::vector<std::string> &before_loop,
+                              const std::vector<std::string> &scalars, const std::string &pool,
+                              const std::string &scalar_array);
 
 } // namespace sicm
