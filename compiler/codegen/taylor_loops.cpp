@@ -35,6 +35,7 @@
 
 #include <algorithm>
 #include <map>
+#include <string_view>
 
 namespace sicm {
 
@@ -60,8 +61,9 @@ struct Token {
   long value;
 };
 
-// The names of arrays and scalars: name -> (kind, number).
-using Names = std::unordered_map<std::string, std::pair<Token::Kind, size_t>>;
+// The names of arrays and scalars: name -> (kind, number). The names are views of strings
+// that outlive the map, so that looking a token up allocates nothing.
+using Names = std::unordered_map<std::string_view, std::pair<Token::Kind, size_t>>;
 
 // The arrays and scalars a text names (and, with indices, the integers it indexes with), in
 // order; numbers are read whole, so the e5 of 1e5 is no name.
@@ -72,7 +74,7 @@ std::vector<Token> tokens_of(const std::string &text, const Names &names, bool i
     if (is_identifier_start(text[i])) {
       while (j < text.size() && is_identifier_char(text[j]))
         ++j;
-      auto it = names.find(text.substr(i, j - i));
+      auto it = names.find(std::string_view(text).substr(i, j - i));
       if (it != names.end()) tokens.push_back({it->second.first, i, j, long(it->second.second)});
     } else if (text[i] >= '0' && text[i] <= '9') {
       bool integer = true;
