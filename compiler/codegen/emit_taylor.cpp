@@ -35,6 +35,11 @@
 // per expansion, so each order costs a matrix-vector convolution and two
 // triangular solves.
 //
+// A large system repeats a few recurrences many times (an N-body problem's
+// pair terms, once per pair): its statements of order k are then loops over
+// the rows of one pool of coefficient arrays (codegen/taylor_loops.cpp),
+// computing the same bits as the straight-line statements of a small one.
+//
 // Limits: tan, asin, acos and variable exponents have no recurrence here
 // (see emit_taylor.hpp); the caller says so and integrates another way.
 #include "codegen/emit_taylor.hpp"
@@ -482,9 +487,10 @@ private:
 
   // The rest of the function when its statements are loops over the rows of one pool of
   // coefficients (codegen/taylor_loops.hpp), the outputs' among them (after reciprocal, the
-  // declaration they read, now first in the order): the pool, on the
-  // heap (it may be larger than a stack), allocated once per thread and kept; when it cannot
-  // be, every coefficient past the state is NaN, which fails the step.
+  // declaration they read, now first in the order). The pool is on the heap (100 bodies'
+  // is 34 MB, more than a stack), allocated at a thread's first call and kept for its
+  // later ones; when it cannot be, every coefficient past the state is NaN, which fails
+  // the step.
   std::string pooled(const TaylorLoops &loops, const std::string &reciprocal) {
     const std::string n = std::to_string(t_.inputs.size());
     std::string f = loops.tables;
