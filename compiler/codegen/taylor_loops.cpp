@@ -19,22 +19,31 @@
 //
 // Every array becomes a row of one pool; rows are numbered in the order the statements
 // write them, so a group writes consecutive rows and many of the rows it reads are affine in
-// the member too (one pair's arrays after another's). A group of at least kMinGroup members
-// is a loop over its members, each slot's row (or constant's number, or index) affine in the
-// member number or read from a static table of ints; a smaller one stays straight-line. The pool
-// lives on the heap, one per thread, allocated once: its size (rows x K coefficients) passes the
-// stack's at about 60 bodies.
+// the member too (one pair's arrays after another's). A group's members run in any order,
+// so those that load the state's components are sorted by component, and the rows of the
+// bodies' coordinates are in the bodies' order. A group of at least kMinGroup members is a
+// loop, each slot's row (or constant's number, or index) an affine function of the loop's
+// counters, else read from a static table of ints; a smaller group stays straight-line. The
+// loop is over the members, or, when that leaves fewer slots in tables, over steps of up to
+// kMaxLanes members (a pair's three components: its force is its inverse cube's row, the
+// step, times its differences', the member), the steps being the pairs first < second of n
+// bodies in order when they are (a difference reads rows 3 first + lane and 3 second + lane,
+// as codegen/loops.cpp's pair loops read in[]). What stays in tables is mostly the sums of
+// the forces, each of whose terms comes from a pair of its own. The pool lives on the heap,
+// one per thread, allocated at its first call: 100 bodies' is 34 MB, more than a stack.
 //
 // Limits: loops only when a group has at least kMinLoopInstances members, so that small
 // systems (Kepler, 10 bodies: 135 products of a pair's inverse cube by its differences) keep
 // their straight-line C as it was, which the heyoka benchmark times. Larger ones ran faster
-// as loops, as the kernels' loops do (codegen/loops.cpp): 16 bodies over 400 time units
-// 0.40 s against 0.49 s straight-line, 32 bodies over 100 0.61 s against 0.85 s; and the C
-// compiler took 10 s and 44 s for their straight-line C, under 1 s for the loops.
+// as loops, as the kernels' loops do (codegen/loops.cpp): 16 bodies over 400 time units in
+// 0.39 s against 0.45-0.48 s straight-line, 32 bodies over 100 in 0.46-0.49 s against
+// 0.69-0.74 s; and the C compiler took 10 s and 44 s for their straight-line C, under 1 s
+// for the loops.
 #include "codegen/taylor_loops.hpp"
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <string_view>
 
 namespace sicm {
@@ -43,6 +52,8 @@ namespace {
 
 constexpr size_t kMinLoopInstances = 256;
 constexpr size_t kMinGroup = 4;
+// A loop may run over up to kMaxLanes members per step (the components of a pair's vectors).
+constexpr size_t kMaxLanes = 8;
 
 bool is_identifier_start(char ch) {
   return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || ch == '_';
@@ -139,6 +150,85 @@ struct Group {
   std::vector<size_t> members;
 };
 
+// How a loop numbers its members: member i alone, or `lanes` members per step (a pair's three
+// components), the steps numbered by `step`, or, when pairs is nonzero, being the pairs
+// first < second of `pairs` bodies in the order (0, 1), (0, 2), ..., (1, 2), ...
+struct LoopForm {
+  size_t lanes = 1, pairs = 0;
+};
+
+// The forms a loop of `count` members may take: flat first, then with lanes, then over pairs.
+std::vector<LoopForm> forms_for(size_t count) {
+  std::vector<LoopForm> forms{{1, 0}};
+  for (size_t lanes = 2; lanes <= kMaxLanes; ++lanes)
+    if (count % lanes == 0 && count / lanes >= 2) forms.push_back({lanes, 0});
+  for (size_t lanes = 1; lanes <= kMaxLanes; ++lanes) {
+    if (count % lanes) continue;
+    size_t n = 3;
+    while (n * (n - 1) / 2 < count / lanes)
+      ++n;
+    if (n * (n - 1) / 2 == count / lanes) forms.push_back({lanes, n});
+  }
+  return forms;
+}
+
+// A column as C: base + the sum of coefficient * counter.
+struct Affine {
+  long base = 0;
+  std::vector<std::pair<long, std::string>> terms;
+
+  std::string text() const {
+    std::string s = std::to_string(base);
+    for (const auto &[coefficient, counter] : terms) {
+      if (coefficient == 0) continue;
+      long magnitude = coefficient < 0 ? -coefficient : coefficient;
+      s += (coefficient < 0 ? " - " : " + ") +
+           (magnitude == 1 ? counter : std::to_string(magnitude) + " * " + counter);
+    }
+    return s;
+  }
+  bool uniform() const {
+    for (const auto &term : terms)
+      if (term.first != 0) return false;
+    return true;
+  }
+};
+
+// v as base + stride * i, if it is one.
+std::optional<Affine> fit_members(const std::vector<long> &v) {
+  const long base = v[0], stride = v.size() > 1 ? v[1] - base : 0;
+  for (size_t m = 0; m < v.size(); ++m)
+    if (v[m] != base + stride * long(m)) return std::nullopt;
+  return Affine{base, {{stride, "i"}}};
+}
+
+// v as an affine function of the counters of form (not flat), if it is one.
+std::optional<Affine> fit_form(const std::vector<long> &v, const LoopForm &form) {
+  const size_t lanes = form.lanes;
+  const long lane_stride = lanes > 1 ? v[1] - v[0] : 0;
+  Affine fit;
+  std::vector<long> predicted(v.size());
+  if (form.pairs == 0) {
+    const long step_stride = v[lanes] - v[0];
+    fit = {v[0], {{step_stride, "step"}, {lane_stride, "lane"}}};
+    for (size_t m = 0; m < v.size(); ++m)
+      predicted[m] = v[0] + step_stride * long(m / lanes) + lane_stride * long(m % lanes);
+  } else {
+    // v = v(0, 1) + sf * first + ss * (second - 1) + sl * lane; (0, 2) is step 1 and (1, 2)
+    // step pairs - 1.
+    const long ss = v[lanes] - v[0];
+    const long sf = v[lanes * (form.pairs - 1)] - v[0] - ss;
+    fit = {v[0] - ss, {{sf, "first"}, {ss, "second"}, {lane_stride, "lane"}}};
+    size_t m = 0;
+    for (size_t a = 0; a < form.pairs; ++a)
+      for (size_t b = a + 1; b < form.pairs; ++b)
+        for (size_t l = 0; l < lanes; ++l, ++m)
+          predicted[m] = fit.base + sf * long(a) + ss * long(b) + lane_stride * long(l);
+  }
+  if (predicted != v) return std::nullopt;
+  return fit;
+}
+
 } // namespace
 
 std::string TaylorLoops::in_pool(const std::string &text) const {
@@ -205,6 +295,21 @@ TaylorLoops plan_taylor_loops(const std::vector<std::string> &statements,
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return groups[a].depth < groups[b].depth; });
 
+  // A group's members are independent (they read only arrays of smaller depths), so they may
+  // run in any order: those that index (the loads of the state's components) in the order
+  // of their indices, so that the rows they write are in that order too.
+  for (Group &group : groups) {
+    auto indices = [&](size_t i) {
+      std::vector<long> v;
+      for (const Token &slot : shapes[i].slots)
+        if (slot.kind == Token::Index) v.push_back(slot.value);
+      return v;
+    };
+    if (!indices(group.members[0]).empty())
+      std::stable_sort(group.members.begin(), group.members.end(),
+                       [&](size_t a, size_t b) { return indices(a) < indices(b); });
+  }
+
   // Rows: the arrays filled before the loop, then the others as the statements write them.
   std::vector<size_t> row(arrays.size(), kNone);
   size_t rows = 0;
@@ -253,38 +358,89 @@ TaylorLoops plan_taylor_loops(const std::vector<std::string> &statements,
       }
       continue;
     }
-    // Slot s in member m: base + stride * m, or the table's next column.
-    std::vector<std::string> slot_text(nslots);
-    std::vector<size_t> tabled;
-    for (size_t s = 0; s < nslots; ++s) {
-      auto value_of_member = [&](size_t m) { return value_at(shapes[members[m]].slots[s]); };
-      const Token &slot = first.slots[s];
-      const long base = value_of_member(0), stride = value_of_member(1) - base;
-      bool affine = true;
-      for (size_t m = 2; m < members.size() && affine; ++m)
-        affine = value_of_member(m) == base + stride * long(m);
-      if (!affine) {
-        slot_text[s] = slot_c(slot, "row[" + std::to_string(tabled.size()) + "]", false);
-        tabled.push_back(s);
-      } else if (stride == 0) {
-        slot_text[s] = slot_c(slot, std::to_string(base), true);
-      } else {
-        std::string step =
-            stride == 1 ? "i" : std::to_string(stride < 0 ? -stride : stride) + " * i";
-        std::string index = std::to_string(base) + (stride < 0 ? " - " : " + ") + step;
-        slot_text[s] = slot_c(slot, slot.kind == Token::Index ? "(" + index + ")" : index, false);
+    // Slot s's values over the members; the form that leaves the fewest in a table.
+    std::vector<std::vector<long>> columns(nslots);
+    for (size_t s = 0; s < nslots; ++s)
+      for (size_t i : members)
+        columns[s].push_back(value_at(shapes[i].slots[s]));
+    std::vector<std::optional<Affine>> fits;
+    LoopForm form;
+    size_t fewest = nslots + 1;
+    for (const LoopForm &candidate : forms_for(members.size())) {
+      std::vector<std::optional<Affine>> candidate_fits;
+      size_t tabled = 0;
+      for (size_t s = 0; s < nslots; ++s) {
+        std::optional<Affine> fit = fit_members(columns[s]);
+        if (!fit && candidate.lanes * std::max<size_t>(candidate.pairs, 1) > 1)
+          fit = fit_form(columns[s], candidate);
+        tabled += !fit;
+        candidate_fits.push_back(std::move(fit));
+      }
+      if (tabled < fewest) {
+        fewest = tabled;
+        form = candidate;
+        fits = std::move(candidate_fits);
       }
     }
-    plan.body += "    for (int i = 0; i < " + std::to_string(members.size()) + "; ++i) {\n";
+    // Slot s as C: its fit, or the table's next column.
+    std::vector<std::string> slot_text(nslots);
+    std::vector<size_t> tabled;
+    bool counts_members = false;
+    for (size_t s = 0; s < nslots; ++s) {
+      const Token &slot = first.slots[s];
+      if (!fits[s]) {
+        slot_text[s] = slot_c(slot, "row[" + std::to_string(tabled.size()) + "]", false);
+        tabled.push_back(s);
+        counts_members = true;
+        continue;
+      }
+      const Affine &fit = *fits[s];
+      std::string index = fit.text();
+      counts_members = counts_members || (!fit.uniform() && fit.terms[0].second == "i");
+      if (fit.uniform())
+        slot_text[s] = slot_c(slot, index, true);
+      else
+        slot_text[s] = slot_c(slot, slot.kind == Token::Index ? "(" + index + ")" : index, false);
+    }
+    // The loops: over the members, or their steps (or pairs) and lanes, counting the members
+    // in i when a slot needs it.
+    const std::string count = std::to_string(members.size()), lanes = std::to_string(form.lanes);
+    const std::string i = counts_members ? ", ++i" : "";
+    std::string indent = "    ";
+    auto open = [&](const std::string &header) {
+      plan.body += indent + header + " {\n";
+      indent += "  ";
+    };
+    if (form.lanes == 1 && form.pairs == 0) {
+      open("for (int i = 0; i < " + count + "; ++i)");
+    } else if (form.pairs == 0) {
+      open("for (int step = 0" + std::string(counts_members ? ", i = 0" : "") + "; step < " +
+           std::to_string(members.size() / form.lanes) + "; ++step)");
+      open("for (int lane = 0; lane < " + lanes + "; ++lane" + i + ")");
+    } else {
+      const std::string n = std::to_string(form.pairs);
+      open("for (int first = 0" + std::string(counts_members ? ", i = 0" : "") + "; first < " + n +
+           "; ++first)");
+      if (form.lanes == 1) {
+        open("for (int second = first + 1; second < " + n + "; ++second" + i + ")");
+      } else {
+        open("for (int second = first + 1; second < " + n + "; ++second)");
+        open("for (int lane = 0; lane < " + lanes + "; ++lane" + i + ")");
+      }
+    }
     if (!tabled.empty()) {
-      plan.body += "      const int *row = " + table + " + " + std::to_string(entries.size());
+      plan.body += indent + "const int *row = " + table + " + " + std::to_string(entries.size());
       plan.body +=
           tabled.size() == 1 ? " + i;\n" : " + " + std::to_string(tabled.size()) + " * i;\n";
-      for (size_t i : members)
+      for (size_t m = 0; m < members.size(); ++m)
         for (size_t s : tabled)
-          entries.push_back(value_at(shapes[i].slots[s]));
+          entries.push_back(columns[s][m]);
     }
-    plan.body += "      " + instantiate(first.text, slot_text) + "\n    }\n";
+    plan.body += indent + instantiate(first.text, slot_text) + "\n";
+    while (indent.size() > 4) {
+      indent.resize(indent.size() - 2);
+      plan.body += indent + "}\n";
+    }
   }
   if (!entries.empty()) {
     plan.tables = "  static const int " + table + "[" + std::to_string(entries.size()) + "] = {";
