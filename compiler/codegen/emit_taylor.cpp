@@ -489,8 +489,10 @@ private:
   // coefficients (codegen/taylor_loops.hpp), the outputs' among them (after reciprocal, the
   // declaration they read, now first in the order). The pool is on the heap (100 bodies'
   // is 34 MB, more than a stack), allocated at a thread's first call and kept for its
-  // later ones; when it cannot be, every coefficient past the state is NaN, which fails
-  // the step.
+  // later ones (the runtime keeps its pool threads too): allocated and freed in each call,
+  // 100 bodies over 5 time units ran in 1.7 s instead of 0.6 s, the pages of a block that
+  // large being mapped afresh each time. When it cannot be allocated, every coefficient
+  // past the state is NaN, which fails the step.
   std::string pooled(const TaylorLoops &loops, const std::string &reciprocal) {
     const std::string n = std::to_string(t_.inputs.size());
     std::string f = loops.tables;
