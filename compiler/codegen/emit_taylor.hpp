@@ -5,7 +5,8 @@
 // outputs as inputs, output f_i the derivative of input x_i (dx_i/dt = f_i,
 // time being one of the inputs when the state has one). Produces: C text
 // (with c_taylor_support() before it in the unit, after <math.h> with
-// _GNU_SOURCE) that compiles warning-free with -std=c11 -Wall -Wextra:
+// _GNU_SOURCE; the text includes <stdlib.h> itself when it allocates)
+// that compiles warning-free with -std=c11 -Wall -Wextra:
 //
 //   void c_name(const double *in, int order, double *c, const double *p)
 //
