@@ -2,6 +2,7 @@
 """bench/taylor-vs-heyoka-aux/heyoka_side.py: the problems of bench/taylor-vs-heyoka by heyoka.
 
 usage: bench/peers/.venv/bin/python heyoka_side.py kepler|nbody [--tol TOL] [--long-double]
+       [--compact] [--bodies N]
            [-r ROUNDS] [--compact]
 
 kepler: the Kepler problem of kepler.sicm (GM = 1, e = .9 from periapsis, the
@@ -49,8 +50,8 @@ def planetary_state(n=10):
     return masses, [float(f"{x:.12g}") for x in state]
 
 
-def nbody(fp):
-    masses, state = planetary_state()
+def nbody(fp, bodies=10):
+    masses, state = planetary_state(bodies)
     system = hy.model.nbody(len(masses), masses=masses, Gconst=1.)
     return system, np.array(state, dtype=fp), 100.
 
@@ -62,9 +63,10 @@ def main():
     p.add_argument("--long-double", action="store_true")
     p.add_argument("--compact", action="store_true", help="heyoka's compact mode")
     p.add_argument("-r", "--rounds", type=int, default=11)
+    p.add_argument("--bodies", type=int, default=10, help="nbody: the star and N - 1 planets")
     a = p.parse_args()
     fp = np.longdouble if a.long_double else np.float64
-    system, state, t_final = (kepler if a.problem == "kepler" else nbody)(fp)
+    system, state, t_final = kepler(fp) if a.problem == "kepler" else nbody(fp, a.bodies)
     t0 = time.perf_counter()
     ta = hy.taylor_adaptive(system, state, tol=fp(a.tol), fp_type=fp, compact_mode=a.compact)
     jit = time.perf_counter() - t0
