@@ -87,6 +87,7 @@ public:
       } else {
         aliases +=
             "#define " + name + " f" + std::to_string(it->second) + " /* the same function */\n";
+        alias_of_[static_cast<int>(f)] = static_cast<int>(it->second);
       }
     }
     std::string main_body = body(0);
@@ -456,6 +457,8 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
   // fN_taylor_extended), generated once; its captures are read from p[] as
   // f reads them. pe/build_mode.cpp checked that it can be generated.
   std::string taylor_function(int f, bool extended, int order) {
+    // A function that stands for another shares its Taylor function too.
+    if (auto a = alias_of_.find(f); a != alias_of_.end()) f = a->second;
     std::string name = "f" + std::to_string(f) + (extended ? "_taylor_extended" : "_taylor");
     if (!taylor_names_.insert(name).second) return name;
     const RFunction &fn = p_.functions[f];
@@ -1003,6 +1006,7 @@ static double sicm_checked_pow(const sicm_site *site, double x, double y) {
   int nsites_ = 0;
   int nprobes_ = 0;
   std::set<std::string> taylor_names_;
+  std::map<int, int> alias_of_; // a function the same as an earlier one -> that one
   std::string taylor_prototypes_, taylor_code_, taylor_extended_code_;
 };
 
