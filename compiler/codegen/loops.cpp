@@ -81,20 +81,35 @@ public:
   // Blocks first; then the outputs they can accumulate; then the blocks again, now knowing
   // which values only those outputs read (they need no array).
   LoopPlan plan() {
+    // A first plan finds the outputs the loops can accumulate (scatters). Its values arrays
+    // are not bounded: it is not emitted, and the values the outputs read need no array
+    // once they are accumulated (the force terms of 300 bodies, 1 MB of them, kept the
+    // pair loop from being found at all when the first plan had to fit).
     find_uses({});
+    values_limit_ = SIZE_MAX;
     find_blocks();
     if (plan_.blocks.empty()) return {};
     std::unordered_set<size_t> scattered = find_scatters();
-    if (scattered.empty()) return std::move(plan_);
-    LoopPlan first = plan_; // valid as it is, keeping every value the outputs read
-    find_uses(scattered);
+    // The plan emitted: its values arrays within kMaxValuesBytes.
+    values_limit_ = kMaxValuesBytes;
+    if (!scattered.empty()) {
+      restart(scattered);
+      if (find_scatters() == scattered) return std::move(plan_);
+    }
+    // Without accumulated outputs: every value they read is kept.
+    restart({});
+    find_scatters();
+    return std::move(plan_);
+  }
+
+  // Blocks found again, the reads of steps `skip` not counted as uses.
+  void restart(const std::unordered_set<size_t> &skip) {
+    find_uses(skip);
     plan_ = {};
     origin_.clear();
     columns_.clear();
     values_bytes_ = 0;
     find_blocks();
-    if (find_scatters() != scattered) return first;
-    return std::move(plan_);
   }
 
 private:
@@ -338,7 +353,7 @@ private:
       for (size_t q = 0; q < npos; ++q)
         if (b.escape[q] < 0 && last_use_[s_.steps[step_of(segs, m, q)].temp] >= end)
           b.escape[q] = int(b.nescape++);
-    if (b.nescape * b.count * sizeof(double) + values_bytes_ > kMaxValuesBytes) return false;
+    if (b.nescape * b.count * sizeof(double) + values_bytes_ > values_limit_) return false;
     values_bytes_ += b.nescape * b.count * sizeof(double);
     std::vector<std::vector<long>> cols;
     for (size_t j = 0; j < insts[0].leaves.size(); ++j) {
@@ -576,6 +591,7 @@ private:
   std::unordered_map<uint32_t, Origin> origin_;
   std::vector<std::vector<std::vector<long>>> columns_; // per block, its slots' indices
   size_t values_bytes_ = 0;
+  size_t values_limit_ = kMaxValuesBytes; // on values_bytes_ (see plan)
   LoopPlan plan_;
 };
 
