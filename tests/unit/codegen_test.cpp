@@ -19,6 +19,7 @@
 #include "eval/procedure.hpp"
 #include "print/printer.hpp"
 #include "syntax/reader.hpp"
+#include "test_files.hpp"
 
 using namespace sicm;
 
@@ -45,8 +46,7 @@ size_t count(const std::string &text, const std::string &what) {
 }
 
 std::string temp_dir() {
-  char tmpl[] = "/tmp/sicm-codegen-XXXXXX";
-  return mkdtemp(tmpl);
+  return sicm_test::make_temp_dir("codegen");
 }
 
 // Set an environment variable for the life of the object, then restore it.

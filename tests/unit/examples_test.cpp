@@ -32,9 +32,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "test_files.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
+
+using sicm_test::slurp;
 
 constexpr const char *kFullLine = "(define example-size 'full)";
 constexpr const char *kSmallLine = "(define example-size 'small)";
@@ -43,13 +47,6 @@ constexpr int kTimeoutSeconds = 60; // per scene; a small run takes about a seco
 const char *sicm_binary() {
   const char *env = std::getenv("SICM_BINARY");
   return env && *env ? env : "build/sicm";
-}
-
-std::string slurp(const fs::path &path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // The scenes, sorted by name: examples/figure-*.sicm and sweep-*.sicm.
@@ -127,11 +124,7 @@ RunResult run_scene(const fs::path &program, const fs::path &dir) {
 }
 
 std::string temp_dir() {
-  std::string base = fs::temp_directory_path().string() + "/sicm-examples-XXXXXX";
-  std::vector<char> tmpl(base.begin(), base.end());
-  tmpl.push_back('\0');
-  const char *made = mkdtemp(tmpl.data());
-  return made ? std::string(made) : std::string();
+  return sicm_test::make_temp_dir("examples");
 }
 
 // Lines of the TSV that are data, not # comments.

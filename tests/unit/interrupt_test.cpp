@@ -12,14 +12,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "test_files.hpp"
+
 namespace {
 
-std::string slurp(const std::string &path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using sicm_test::slurp;
 
 const char *sicm_binary() {
   const char *env = std::getenv("SICM_BINARY");
@@ -64,8 +61,7 @@ void expect_complete_files(const std::string &dir) {
 }
 
 std::string temp_dir() {
-  char tmpl[] = "/tmp/sicm-interrupt-XXXXXX";
-  return mkdtemp(tmpl);
+  return sicm_test::make_temp_dir("interrupt");
 }
 
 } // namespace

@@ -25,10 +25,13 @@
 #include <unistd.h>
 
 #include "codegen/jit.hpp"
+#include "test_files.hpp"
 
 using namespace sicm;
 
 namespace {
+
+using sicm_test::slurp;
 
 using KernelFn = void (*)(const double *in, double *out, const double *p);
 
@@ -46,17 +49,9 @@ struct TempDirs {
 } g_temp_dirs;
 
 std::string temp_dir() {
-  char tmpl[] = "/tmp/sicm-jitcache-XXXXXX";
-  std::string dir = mkdtemp(tmpl);
+  std::string dir = sicm_test::make_temp_dir("jitcache");
   g_temp_dirs.paths.push_back(dir);
   return dir;
-}
-
-std::string slurp(const std::string &path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 void spit(const std::string &path, const std::string &bytes, mode_t mode = 0600) {

@@ -19,6 +19,7 @@
 #include "base/limits.hpp"
 #include "eval/interp.hpp"
 #include "syntax/reader.hpp"
+#include "test_files.hpp"
 
 using namespace sicm;
 
@@ -198,8 +199,7 @@ bool have_sicm() {
 }
 
 std::string temp_dir() {
-  char tmpl[] = "/tmp/sicm-limits-XXXXXX";
-  return mkdtemp(tmpl);
+  return sicm_test::make_temp_dir("limits");
 }
 
 using Clock = std::chrono::steady_clock;

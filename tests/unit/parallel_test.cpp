@@ -15,8 +15,11 @@
 #include <unistd.h>
 
 #include "sicm/runtime.h"
+#include "test_files.hpp"
 
 namespace {
+
+using sicm_test::slurp;
 
 const sicm_site kSite = {"sweep.sicm:3:1", "(parallel-map f xs)", 1};
 
@@ -50,16 +53,8 @@ std::string run_printers(int threads, size_t n) {
   return testing::internal::GetCapturedStdout();
 }
 
-std::string slurp(const std::string &path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 std::string temp_dir() {
-  char tmpl[] = "/tmp/sicm-parallel-XXXXXX";
-  return mkdtemp(tmpl);
+  return sicm_test::make_temp_dir("parallel");
 }
 
 // sicm_program_init as a built program calls it, keeping the error hook of

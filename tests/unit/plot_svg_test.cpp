@@ -18,19 +18,14 @@
 #include <unistd.h>
 
 #include "sicm/runtime.h"
+#include "test_files.hpp"
 
 namespace {
 
-std::string slurp(const std::string &path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using sicm_test::slurp;
 
 std::string temp_dir() {
-  char tmpl[] = "/tmp/sicm-plot-svg-XXXXXX";
-  return mkdtemp(tmpl);
+  return sicm_test::make_temp_dir("plot-svg");
 }
 
 // One element of the document: its name and attributes.

@@ -12,15 +12,11 @@
 #include <unistd.h>
 
 #include "sicm/runtime.h"
+#include "test_files.hpp"
 
 namespace {
 
-std::string slurp(const std::string &path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using sicm_test::slurp;
 
 bool exists(const std::string &path) {
   struct stat st;
@@ -28,8 +24,7 @@ bool exists(const std::string &path) {
 }
 
 std::string temp_dir() {
-  char tmpl[] = "/tmp/sicm-plot-XXXXXX";
-  return mkdtemp(tmpl);
+  return sicm_test::make_temp_dir("plot");
 }
 
 } // namespace
