@@ -90,7 +90,9 @@ public:
     find_blocks();
     if (plan_.blocks.empty()) return {};
     std::unordered_set<size_t> scattered = find_scatters();
-    // The plan emitted: its values arrays within kMaxValuesBytes.
+    // The plan emitted: its values arrays within kMaxValuesBytes (the first one, when it
+    // accumulates nothing and fits).
+    if (scattered.empty() && values_bytes_ <= kMaxValuesBytes) return std::move(plan_);
     values_limit_ = kMaxValuesBytes;
     if (!scattered.empty()) {
       restart(scattered);
